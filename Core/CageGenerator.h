@@ -1,0 +1,45 @@
+// SDFCage — Core: the whole pipeline, mesh in input coordinates -> cage in input coordinates.
+#pragma once
+
+#include "Envelope.h"
+#include "Normalization.h"
+#include "Validation.h"
+
+namespace sdfcage
+{
+
+struct CageOptions
+{
+  EnvelopeOptions Envelope;
+  ValidationOptions Validation;
+};
+
+struct CageResult
+{
+  Status State = Status::Failed;
+  std::string Message;              ///< error or cancellation reason (empty when Ok)
+  MeshDefects Defects;              ///< validation report of the input
+  TriangleMesh Cage;                ///< input coordinates (for now: the verified envelope)
+  std::vector<double> CageDistanceToInput; ///< per cage point, input units
+  TriangleMesh Envelope;            ///< input coordinates
+  std::vector<double> EnvelopeDistanceToInput; ///< per envelope point, input units
+  double MinimumClearance = 0.0;    ///< measured, input units
+  double MinimumClearanceRelative = 0.0; ///< measured, unit-sphere units
+  bool EnclosureVerified = false;
+  int RemovedPockets = 0;
+  int EnvelopeGenus = 0;
+  int EnvelopeComponents = 0;
+  double VoxelSizeUsed = 0.0;       ///< unit-sphere units
+  double ValidationSeconds = 0.0;
+  double DistanceFieldSeconds = 0.0;
+  double IsosurfaceSeconds = 0.0;
+  double VerificationSeconds = 0.0;
+  double TotalSeconds = 0.0;
+  ScalarImage DistanceField;        ///< input coordinates and units, when requested
+  Normalization Normalize;
+};
+
+CageResult generateCage(const PolygonMesh& input, const CageOptions& options,
+  Progress* progress = nullptr);
+
+} // namespace sdfcage

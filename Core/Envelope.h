@@ -1,0 +1,89 @@
+// SDFCage — Core: the verified SDF envelope (paper §3.1, without active points yet).
+#pragma once
+
+#include "Mesh.h"
+
+#include <array>
+#include <string>
+#include <vector>
+
+namespace sdfcage
+{
+
+class Progress;
+
+/// All lengths in unit-sphere units (the input is normalized first).
+struct EnvelopeOptions
+{
+  /// Isovalue c of the envelope {xi = c} (paper default 0.01).
+  double IsoValue = 0.01;
+  /// Voxel size h of the SDF grid; 0 = automatic (IsoValue / 2, which keeps the genus of the
+  /// shared test meshes and a clearance of about c/2).
+  double VoxelSize = 0.0;
+  /// Clearance delta that every envelope triangle must keep from every input triangle;
+  /// 0 = automatic (IsoValue / 4).
+  double MinimumClearance = 0.0;
+  /// If verification fails, retry up to this many times with half the voxel size.
+  int MaximumRefinements = 2;
+  /// Keep the sampled SDF as a dense image (for display).
+  bool KeepDistanceField = false;
+  /// Worker threads (0 = all cores).
+  int NumberOfThreads = 0;
+
+  double voxelSize() const { return VoxelSize > 0 ? VoxelSize : IsoValue / 2; }
+  double clearance() const { return MinimumClearance > 0 ? MinimumClearance : IsoValue / 4; }
+};
+
+/// A dense sampled scalar field (point data on a regular grid, x fastest).
+struct ScalarImage
+{
+  std::array<int, 3> Dimensions{ 0, 0, 0 };
+  Vec3 Origin = Vec3::Zero();
+  double Spacing = 1.0;
+  std::vector<float> Values;
+};
+
+enum class Status
+{
+  Ok = 0,
+  EmptyInput,
+  InvalidInput,
+  Cancelled,
+  VerificationFailed,
+  Failed
+};
+
+const char* statusName(Status s);
+
+struct EnvelopeResult
+{
+  Status State = Status::Failed;
+  std::string Message;              ///< what went wrong (empty when Ok)
+  TriangleMesh Envelope;            ///< outer envelope, outward oriented, unit-sphere units
+  std::vector<double> DistanceToInput; ///< per envelope point, unsigned, unit-sphere units
+  double MinimumClearance = 0.0;    ///< exact min triangle-triangle distance, unit-sphere units
+  bool EnclosureVerified = false;   ///< clearance >= delta, input inside, closed manifold
+  int RemovedPockets = 0;           ///< trapped air pockets (inner components) removed
+  int Components = 0;               ///< components of the kept envelope
+  int Genus = 0;                    ///< genus of the kept envelope
+  double VoxelSizeUsed = 0.0;       ///< after any refinement
+  int Refinements = 0;              ///< how often the grid had to be refined
+  double DistanceFieldSeconds = 0.0;
+  double IsosurfaceSeconds = 0.0;
+  double VerificationSeconds = 0.0;
+  ScalarImage DistanceField;        ///< filled when KeepDistanceField (unit-sphere units)
+};
+
+/// Builds and verifies the envelope of a validated, normalized mesh (unit-sphere units).
+EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOptions& options,
+  Progress* progress = nullptr);
+
+/// Independent check used by buildEnvelope and by tests: closed 2-manifold, every triangle of
+/// `cage` at least `clearance` from `input` (exact distances), and one point of every input
+/// component inside (winding number). Returns the measured exact minimum clearance in
+/// `measuredClearance` and per-cage-point distances in `pointDistances` (if non-null).
+bool verifyEnclosure(const TriangleMesh& input, const TriangleMesh& cage, double clearance,
+  double& measuredClearance, std::string& why, std::vector<double>* pointDistances = nullptr,
+  Progress* progress = nullptr);
+
+} // namespace sdfcage

@@ -1,0 +1,65 @@
+// SDFCage — Core: triangle and polygon mesh types (no VTK).
+#pragma once
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+namespace sdfcage
+{
+
+using Vec3 = Eigen::Vector3d;
+using Triangle = std::array<int, 3>;
+
+/// A triangle mesh: #V points and #F triangles (indices into Points, counter-clockwise seen from
+/// outside for a closed, outward-oriented mesh).
+struct TriangleMesh
+{
+  std::vector<Vec3> Points;
+  std::vector<Triangle> Triangles;
+
+  std::size_t numberOfPoints() const { return Points.size(); }
+  std::size_t numberOfTriangles() const { return Triangles.size(); }
+  bool empty() const { return Triangles.empty(); }
+};
+
+/// A polygon mesh as readers deliver it: cells of any size in compressed form (cell c uses
+/// Connectivity[Offsets[c] .. Offsets[c+1])). Offsets has #cells + 1 entries.
+/// Cells with fewer than 3 points (vertices, lines) are counted and ignored by validation.
+struct PolygonMesh
+{
+  std::vector<Vec3> Points;
+  std::vector<std::int64_t> Offsets{ 0 };
+  std::vector<std::int64_t> Connectivity;
+
+  std::size_t numberOfCells() const { return Offsets.empty() ? 0 : Offsets.size() - 1; }
+  void addCell(std::initializer_list<std::int64_t> ids)
+  {
+    Connectivity.insert(Connectivity.end(), ids.begin(), ids.end());
+    Offsets.push_back(static_cast<std::int64_t>(Connectivity.size()));
+  }
+  static PolygonMesh fromTriangles(const TriangleMesh& mesh);
+};
+
+/// Signed volume enclosed by a closed mesh (positive when outward oriented).
+double signedVolume(const TriangleMesh& mesh);
+
+/// Connected components over shared vertices: returns the component id per triangle and the
+/// number of components.
+int triangleComponents(const TriangleMesh& mesh, std::vector<int>& componentOfTriangle);
+
+/// Euler characteristic V - E + F counted over referenced vertices and unique undirected edges.
+long long eulerCharacteristic(const TriangleMesh& mesh);
+
+/// Total genus of a closed 2-manifold mesh: sum over components of (2 - chi_i) / 2.
+int genus(const TriangleMesh& mesh);
+
+/// Axis-aligned bounds {min, max}.
+std::array<Vec3, 2> bounds(const TriangleMesh& mesh);
+
+/// Removes points no triangle references; keeps the order of the others.
+void removeUnreferencedPoints(TriangleMesh& mesh);
+
+} // namespace sdfcage
