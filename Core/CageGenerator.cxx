@@ -1,0 +1,108 @@
+#include "CageGenerator.h"
+
+#include "Progress.h"
+
+#include <tbb/global_control.h>
+
+#include <chrono>
+#include <memory>
+
+namespace sdfcage
+{
+
+namespace
+{
+double seconds(std::chrono::steady_clock::time_point t0)
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+} // namespace
+
+CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Progress* progress)
+{
+  CageResult result;
+  const auto start = std::chrono::steady_clock::now();
+  std::unique_ptr<tbb::global_control> threads;
+  if (options.Envelope.NumberOfThreads > 0)
+  {
+    threads = std::make_unique<tbb::global_control>(
+      tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(options.Envelope.NumberOfThreads));
+  }
+
+  // 1. validation
+  progressStage(progress, "validating input", 0.0, 0.02);
+  TriangleMesh mesh;
+  result.Defects = prepareMesh(input, mesh, options.Validation);
+  result.ValidationSeconds = seconds(start);
+  if (result.Defects.Empty && result.Defects.usable() == false &&
+    result.Defects.NonFinitePoints == 0 && result.Defects.InvalidPointIds == 0 &&
+    result.Defects.UntriangulatedPolygons == 0)
+  {
+    result.State = Status::EmptyInput;
+    result.Message = "the input has no triangles";
+    return result;
+  }
+  if (!result.Defects.usable())
+  {
+    result.State = Status::InvalidInput;
+    result.Message = result.Defects.errorMessage();
+    return result;
+  }
+  if (progressCancelled(progress))
+  {
+    result.State = Status::Cancelled;
+    result.Message = "cancelled";
+    return result;
+  }
+
+  // 2. normalization into the unit sphere: every length parameter is relative to it
+  result.Normalize = Normalization::fit(mesh);
+  const Normalization& n = result.Normalize;
+  const TriangleMesh unit = n.toUnit(mesh);
+
+  // 3. the verified envelope
+  EnvelopeResult env = buildEnvelope(unit, options.Envelope, progress);
+  result.DistanceFieldSeconds = env.DistanceFieldSeconds;
+  result.IsosurfaceSeconds = env.IsosurfaceSeconds;
+  result.VerificationSeconds = env.VerificationSeconds;
+  result.VoxelSizeUsed = env.VoxelSizeUsed;
+  result.RemovedPockets = env.RemovedPockets;
+  result.TotalSeconds = seconds(start);
+  if (env.State != Status::Ok)
+  {
+    result.State = env.State;
+    result.Message = env.Message;
+    return result;
+  }
+  result.EnclosureVerified = env.EnclosureVerified;
+  result.MinimumClearanceRelative = env.MinimumClearance;
+  result.MinimumClearance = n.lengthToInput(env.MinimumClearance);
+  result.EnvelopeGenus = env.Genus;
+  result.EnvelopeComponents = env.Components;
+  result.Envelope = n.toInput(env.Envelope);
+  result.EnvelopeDistanceToInput.resize(env.DistanceToInput.size());
+  for (std::size_t i = 0; i < env.DistanceToInput.size(); ++i)
+  {
+    result.EnvelopeDistanceToInput[i] = n.lengthToInput(env.DistanceToInput[i]);
+  }
+  if (options.Envelope.KeepDistanceField)
+  {
+    result.DistanceField = std::move(env.DistanceField);
+    result.DistanceField.Origin = n.toInput(result.DistanceField.Origin);
+    result.DistanceField.Spacing = n.lengthToInput(result.DistanceField.Spacing);
+    for (float& v : result.DistanceField.Values)
+    {
+      v = static_cast<float>(n.lengthToInput(v));
+    }
+  }
+
+  // 4. the cage: for now the verified envelope itself (a valid dense cage)
+  result.Cage = result.Envelope;
+  result.CageDistanceToInput = result.EnvelopeDistanceToInput;
+  result.State = Status::Ok;
+  result.TotalSeconds = seconds(start);
+  progressUpdate(progress, 1.0);
+  return result;
+}
+
+} // namespace sdfcage

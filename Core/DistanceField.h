@@ -1,0 +1,32 @@
+// SDFCage — Core (internal): the OpenVDB part of the pipeline, kept in one translation unit
+// because OpenVDB's mesh tools are slow to compile.
+#pragma once
+
+#include "Envelope.h"
+#include "Mesh.h"
+
+#include <string>
+
+namespace sdfcage
+{
+
+class Progress;
+
+struct IsosurfaceOutput
+{
+  TriangleMesh Surface;   ///< the isosurface {xi = iso}, triangles (quads split), unit units
+  ScalarImage Field;      ///< dense samples of xi, when requested
+  bool Cancelled = false;
+  std::string Error;
+  double DistanceFieldSeconds = 0.0;
+  double IsosurfaceSeconds = 0.0;
+  std::size_t ActiveVoxels = 0;
+};
+
+/// Narrow-band SDF of a closed (possibly self-intersecting) mesh with OpenVDB (sign by flood
+/// fill), wide enough outside for `iso`, then marching-cubes-style extraction at `iso`.
+/// Progress: fractions 0..0.6 for the SDF, 0.6..1 for the surface of the current stage.
+IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSize, double iso,
+  bool keepField, Progress* progress);
+
+} // namespace sdfcage

@@ -1,0 +1,346 @@
+#include "Envelope.h"
+
+#include "DistanceField.h"
+#include "Geometry.h"
+#include "Progress.h"
+#include "TriangleIndex.h"
+#include "Validation.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <sstream>
+
+namespace sdfcage
+{
+
+const char* statusName(Status s)
+{
+  switch (s)
+  {
+    case Status::Ok:
+      return "ok";
+    case Status::EmptyInput:
+      return "empty input";
+    case Status::InvalidInput:
+      return "invalid input";
+    case Status::Cancelled:
+      return "cancelled";
+    case Status::VerificationFailed:
+      return "verification failed";
+    case Status::Failed:
+      return "failed";
+  }
+  return "unknown";
+}
+
+namespace
+{
+
+double seconds(std::chrono::steady_clock::time_point t0)
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+TriangleMesh keepTriangles(const TriangleMesh& mesh, const std::vector<char>& keep)
+{
+  TriangleMesh out;
+  out.Points = mesh.Points;
+  for (std::size_t f = 0; f < mesh.Triangles.size(); ++f)
+  {
+    if (keep[f])
+    {
+      out.Triangles.push_back(mesh.Triangles[f]);
+    }
+  }
+  removeUnreferencedPoints(out);
+  return out;
+}
+
+/// Keeps the outer boundary: components with negative volume bound trapped air pockets (they face
+/// into the pocket), and positive components nested inside another one are redundant.
+TriangleMesh outerBoundary(const TriangleMesh& surface, int& removed)
+{
+  std::vector<int> comp;
+  const int n = triangleComponents(surface, comp);
+  std::vector<double> volume(n, 0.0);
+  std::vector<int> someVertex(n, -1);
+  for (std::size_t f = 0; f < surface.Triangles.size(); ++f)
+  {
+    const Triangle& t = surface.Triangles[f];
+    volume[comp[f]] += surface.Points[t[0]].dot(surface.Points[t[1]].cross(surface.Points[t[2]])) / 6.0;
+    someVertex[comp[f]] = t[0];
+  }
+  std::vector<char> keepComponent(n, 0);
+  for (int c = 0; c < n; ++c)
+  {
+    keepComponent[c] = volume[c] > 0.0;
+  }
+  // nested positive components (a part inside a cavity of another part)
+  int positive = static_cast<int>(std::count(keepComponent.begin(), keepComponent.end(), 1));
+  if (positive > 1)
+  {
+    for (int c = 0; c < n; ++c)
+    {
+      if (!keepComponent[c])
+      {
+        continue;
+      }
+      for (int o = 0; o < n; ++o)
+      {
+        if (o == c || volume[o] <= 0.0)
+        {
+          continue;
+        }
+        std::vector<char> k(surface.Triangles.size(), 0);
+        for (std::size_t f = 0; f < k.size(); ++f)
+        {
+          k[f] = comp[f] == o;
+        }
+        TriangleMesh other = keepTriangles(surface, k);
+        if (windingNumber(other, surface.Points[someVertex[c]]) > 0.5)
+        {
+          keepComponent[c] = 0;
+          break;
+        }
+      }
+    }
+  }
+  removed = 0;
+  for (int c = 0; c < n; ++c)
+  {
+    removed += !keepComponent[c];
+  }
+  std::vector<char> keep(surface.Triangles.size(), 0);
+  for (std::size_t f = 0; f < keep.size(); ++f)
+  {
+    keep[f] = keepComponent[comp[f]];
+  }
+  return keepTriangles(surface, keep);
+}
+
+} // namespace
+
+bool verifyEnclosure(const TriangleMesh& input, const TriangleMesh& cage, double clearance,
+  double& measuredClearance, std::string& why, std::vector<double>* pointDistances, Progress* progress)
+{
+  measuredClearance = 0.0;
+  why.clear();
+  const MeshDefects d = checkTriangleMesh(cage);
+  if (!d.usable())
+  {
+    why = "the surface is not a closed 2-manifold: " + d.errorMessage();
+    return false;
+  }
+  TriangleIndex index;
+  index.build(input);
+
+  // 1. exact distance of every cage point to the input
+  const std::size_t nv = cage.Points.size();
+  std::vector<double> dist(nv, 0.0);
+  std::atomic<std::size_t> done{ 0 };
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nv, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+    if (progressCancelled(progress))
+    {
+      return;
+    }
+    for (std::size_t i = r.begin(); i != r.end(); ++i)
+    {
+      dist[i] = index.distance(cage.Points[i]);
+    }
+    const std::size_t n = done.fetch_add(r.size()) + r.size();
+    progressUpdate(progress, 0.6 * static_cast<double>(n) / static_cast<double>(std::max<std::size_t>(nv, 1)));
+  });
+  if (progressCancelled(progress))
+  {
+    why = "cancelled";
+    return false;
+  }
+  double upper = std::numeric_limits<double>::infinity();
+  for (double v : dist)
+  {
+    upper = std::min(upper, v);
+  }
+
+  // 2. per triangle, a Lipschitz lower bound from its corners: the distance to the input changes
+  // by at most the distance travelled. Exact triangle-triangle distances only where the bound
+  // does not already prove the triangle both clear of delta and above the running minimum.
+  const std::size_t nf = cage.Triangles.size();
+  std::vector<std::pair<double, int>> uncertain; // (lower bound, triangle)
+  for (std::size_t f = 0; f < nf; ++f)
+  {
+    const Triangle& t = cage.Triangles[f];
+    double lower = -std::numeric_limits<double>::infinity();
+    for (int i = 0; i < 3; ++i)
+    {
+      const Vec3& p = cage.Points[t[i]];
+      const double reach = std::max((cage.Points[t[(i + 1) % 3]] - p).norm(), (cage.Points[t[(i + 2) % 3]] - p).norm());
+      lower = std::max(lower, dist[t[i]] - reach);
+    }
+    if (lower < upper)
+    {
+      uncertain.emplace_back(lower, static_cast<int>(f));
+    }
+  }
+  std::sort(uncertain.begin(), uncertain.end());
+  // process in increasing lower-bound order, in parallel chunks, stopping once the bound passes
+  // the best exact value found so far
+  std::atomic<double> best{ upper };
+  const std::size_t chunk = 4096;
+  for (std::size_t b = 0; b < uncertain.size(); b += chunk)
+  {
+    if (uncertain[b].first >= best.load())
+    {
+      break;
+    }
+    if (progressCancelled(progress))
+    {
+      why = "cancelled";
+      return false;
+    }
+    const std::size_t e = std::min(uncertain.size(), b + chunk);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(b, e, 64), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t k = r.begin(); k != r.end(); ++k)
+      {
+        const double limit = best.load();
+        if (uncertain[k].first >= limit)
+        {
+          continue;
+        }
+        const Triangle& t = cage.Triangles[uncertain[k].second];
+        const Vec3 tri[3] = { cage.Points[t[0]], cage.Points[t[1]], cage.Points[t[2]] };
+        const double dd = index.triangleDistance(tri, limit);
+        double cur = best.load();
+        while (dd < cur && !best.compare_exchange_weak(cur, dd))
+        {
+        }
+      }
+    });
+    progressUpdate(progress, 0.6 + 0.3 * static_cast<double>(e) / static_cast<double>(uncertain.size()));
+  }
+  measuredClearance = best.load();
+  if (pointDistances)
+  {
+    *pointDistances = std::move(dist);
+  }
+  if (!(measuredClearance >= clearance))
+  {
+    std::ostringstream s;
+    s << "the surface comes within " << measuredClearance << " of the input (required clearance "
+      << clearance << ")";
+    why = s.str();
+    return false;
+  }
+
+  // 3. enclosure: the surface never comes near the input, so each input component lies entirely
+  // inside or entirely outside; test one vertex per component by winding number.
+  std::vector<int> comp;
+  const int ncomp = triangleComponents(input, comp);
+  std::vector<int> probe(ncomp, -1);
+  for (std::size_t f = 0; f < input.Triangles.size(); ++f)
+  {
+    if (probe[comp[f]] < 0)
+    {
+      probe[comp[f]] = input.Triangles[f][0];
+    }
+  }
+  int outside = 0;
+  for (int c = 0; c < ncomp; ++c)
+  {
+    if (windingNumber(cage, input.Points[probe[c]]) < 0.5)
+    {
+      ++outside;
+    }
+  }
+  progressUpdate(progress, 1.0);
+  if (outside > 0)
+  {
+    why = std::to_string(outside) + " input components are not inside the surface";
+    return false;
+  }
+  return true;
+}
+
+EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOptions& options, Progress* progress)
+{
+  EnvelopeResult result;
+  if (unitInput.empty())
+  {
+    result.State = Status::EmptyInput;
+    result.Message = "the input has no triangles";
+    return result;
+  }
+  const double c = options.IsoValue;
+  double h = options.voxelSize();
+  const double delta = options.clearance();
+  if (!(c > 0.0) || !(h > 0.0) || !(delta > 0.0) || delta >= c)
+  {
+    result.State = Status::InvalidInput;
+    result.Message = "invalid parameters: need IsoValue > 0, VoxelSize > 0 and 0 < MinimumClearance < IsoValue";
+    return result;
+  }
+  for (int attempt = 0; attempt <= std::max(0, options.MaximumRefinements); ++attempt, h *= 0.5)
+  {
+    progressStage(progress, "distance field and isosurface", 0.02, 0.7);
+    IsosurfaceOutput iso = computeIsosurface(unitInput, h, c, options.KeepDistanceField, progress);
+    result.DistanceFieldSeconds += iso.DistanceFieldSeconds;
+    result.IsosurfaceSeconds += iso.IsosurfaceSeconds;
+    if (iso.Cancelled)
+    {
+      result.State = Status::Cancelled;
+      result.Message = "cancelled";
+      return result;
+    }
+    if (!iso.Error.empty())
+    {
+      result.State = Status::Failed;
+      result.Message = iso.Error;
+      return result;
+    }
+    auto t0 = std::chrono::steady_clock::now();
+    result.Envelope = outerBoundary(iso.Surface, result.RemovedPockets);
+    result.IsosurfaceSeconds += seconds(t0);
+    result.VoxelSizeUsed = h;
+    result.Refinements = attempt;
+    result.DistanceField = std::move(iso.Field);
+
+    progressStage(progress, "verifying enclosure", 0.7, 1.0);
+    auto t1 = std::chrono::steady_clock::now();
+    std::string why;
+    const bool ok = verifyEnclosure(unitInput, result.Envelope, delta, result.MinimumClearance, why,
+      &result.DistanceToInput, progress);
+    result.VerificationSeconds += seconds(t1);
+    if (progressCancelled(progress))
+    {
+      result.State = Status::Cancelled;
+      result.Message = "cancelled";
+      return result;
+    }
+    if (ok)
+    {
+      std::vector<int> comp;
+      result.Components = triangleComponents(result.Envelope, comp);
+      result.Genus = genus(result.Envelope);
+      result.EnclosureVerified = true;
+      result.State = Status::Ok;
+      result.Message.clear();
+      return result;
+    }
+    std::ostringstream s;
+    s << "envelope at voxel size " << h << " failed verification: " << why;
+    result.Message = s.str();
+  }
+  result.State = Status::VerificationFailed;
+  result.EnclosureVerified = false;
+  result.Message += " (after refining the grid " + std::to_string(options.MaximumRefinements) +
+    " times; try a larger IsoValue or a smaller VoxelSize)";
+  return result;
+}
+
+} // namespace sdfcage
