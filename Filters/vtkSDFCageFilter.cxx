@@ -1,0 +1,524 @@
+/*=========================================================================
+
+  Program:   SDFCage
+  Module:    vtkSDFCageFilter.cxx
+
+=========================================================================*/
+#include "vtkSDFCageFilter.h"
+
+#include "vtkCellArray.h"
+#include "vtkCellArrayIterator.h"
+#include "vtkDataObject.h"
+#include "vtkDoubleArray.h"
+#include "vtkFieldData.h"
+#include "vtkFloatArray.h"
+#include "vtkIdTypeArray.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkIntArray.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkSmartPointer.h"
+#include "vtkStringArray.h"
+
+#include "CageGenerator.h"
+#include "Progress.h"
+
+#include <exception>
+#include <new>
+#include <sstream>
+#include <thread>
+
+vtkStandardNewMacro(vtkSDFCageFilter);
+
+namespace
+{
+//------------------------------------------------------------------------------
+// Forwards Core's progress to the filter, and the filter's abort flag to Core.
+// Core may call report()/pollCancel() from worker threads; VTK objects are only touched from the
+// thread that runs RequestData (the one that constructed this object). Cancellation still reaches
+// the workers: Progress latches the flag in an atomic once pollCancel() has returned true.
+class FilterProgress final : public sdfcage::Progress
+{
+public:
+  explicit FilterProgress(vtkSDFCageFilter* filter)
+    : Filter(filter)
+    , Owner(std::this_thread::get_id())
+  {
+  }
+
+protected:
+  void report(double overall, const std::string& stage) override
+  {
+    if (std::this_thread::get_id() != this->Owner)
+    {
+      return;
+    }
+    // Throttle: a new stage always shows; inside a stage, report every 1% at most (each
+    // UpdateProgress fires observers, which in ParaView repaint a progress bar).
+    const bool newStage = stage != this->LastStage;
+    if (!newStage && overall < this->LastReported + 0.01)
+    {
+      return;
+    }
+    if (newStage)
+    {
+      this->LastStage = stage;
+      this->Filter->SetProgressText(stage.c_str());
+    }
+    this->LastReported = overall;
+    this->Filter->UpdateProgress(overall);
+  }
+
+  bool pollCancel() override
+  {
+    return std::this_thread::get_id() == this->Owner && this->Filter->GetAbortExecute() != 0;
+  }
+
+private:
+  vtkSDFCageFilter* Filter;
+  std::thread::id Owner;
+  std::string LastStage;
+  double LastReported = -1.0;
+};
+
+//------------------------------------------------------------------------------
+// Appends the cells of `cells` to `mesh`. Polygons are copied as they are (Core triangulates
+// them and reports what it could not split). Triangle strips are split here; the degenerate
+// triangles a strip uses to turn (two equal ids) are an artifact of the encoding, not of the
+// surface, and are skipped. Vertex and line cells are passed as 1- and 2-point cells so that
+// Core counts them as ignored cells.
+enum class CellKind
+{
+  Vertex,
+  Line,
+  Polygon,
+  Strip
+};
+
+void AppendCells(vtkCellArray* cells, CellKind kind, sdfcage::PolygonMesh& mesh)
+{
+  if (!cells || cells->GetNumberOfCells() == 0)
+  {
+    return;
+  }
+  auto it = vtk::TakeSmartPointer(cells->NewIterator());
+  vtkIdType npts = 0;
+  const vtkIdType* pts = nullptr;
+  for (it->GoToFirstCell(); !it->IsDoneWithTraversal(); it->GoToNextCell())
+  {
+    it->GetCurrentCell(npts, pts);
+    switch (kind)
+    {
+      case CellKind::Vertex:
+        if (npts >= 1)
+        {
+          mesh.addCell({ pts[0] });
+        }
+        break;
+      case CellKind::Line:
+        if (npts >= 2)
+        {
+          mesh.addCell({ pts[0], pts[1] });
+        }
+        break;
+      case CellKind::Polygon:
+        mesh.Connectivity.insert(mesh.Connectivity.end(), pts, pts + npts);
+        mesh.Offsets.push_back(static_cast<std::int64_t>(mesh.Connectivity.size()));
+        break;
+      case CellKind::Strip:
+        for (vtkIdType i = 0; i + 2 < npts; ++i)
+        {
+          vtkIdType a = pts[i], b = pts[i + 1];
+          const vtkIdType c = pts[i + 2];
+          if (a == b || b == c || a == c)
+          {
+            continue;
+          }
+          if (i % 2 == 1)
+          {
+            std::swap(a, b); // odd triangles of a strip are wound the other way
+          }
+          mesh.addCell({ a, b, c });
+        }
+        break;
+    }
+  }
+}
+
+void ToPolygonMesh(vtkPolyData* input, sdfcage::PolygonMesh& mesh)
+{
+  const vtkIdType numberOfPoints = input->GetNumberOfPoints();
+  mesh.Points.resize(static_cast<std::size_t>(numberOfPoints));
+  double p[3];
+  for (vtkIdType i = 0; i < numberOfPoints; ++i)
+  {
+    input->GetPoint(i, p);
+    mesh.Points[static_cast<std::size_t>(i)] = sdfcage::Vec3(p[0], p[1], p[2]);
+  }
+  mesh.Offsets.assign(1, 0);
+  mesh.Connectivity.clear();
+  if (vtkCellArray* polys = input->GetPolys())
+  {
+    mesh.Connectivity.reserve(static_cast<std::size_t>(polys->GetNumberOfConnectivityIds()));
+    mesh.Offsets.reserve(static_cast<std::size_t>(polys->GetNumberOfCells()) + 1);
+  }
+  AppendCells(input->GetPolys(), CellKind::Polygon, mesh);
+  AppendCells(input->GetStrips(), CellKind::Strip, mesh);
+  AppendCells(input->GetVerts(), CellKind::Vertex, mesh);
+  AppendCells(input->GetLines(), CellKind::Line, mesh);
+}
+
+void ToPolyData(
+  const sdfcage::TriangleMesh& mesh, const std::vector<double>& distance, vtkPolyData* output)
+{
+  const vtkIdType numberOfPoints = static_cast<vtkIdType>(mesh.numberOfPoints());
+  const vtkIdType numberOfTriangles = static_cast<vtkIdType>(mesh.numberOfTriangles());
+
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(numberOfPoints);
+  for (vtkIdType i = 0; i < numberOfPoints; ++i)
+  {
+    points->SetPoint(i, mesh.Points[static_cast<std::size_t>(i)].data());
+  }
+
+  vtkNew<vtkIdTypeArray> offsets;
+  vtkNew<vtkIdTypeArray> connectivity;
+  offsets->SetNumberOfValues(numberOfTriangles + 1);
+  connectivity->SetNumberOfValues(3 * numberOfTriangles);
+  for (vtkIdType t = 0; t < numberOfTriangles; ++t)
+  {
+    const sdfcage::Triangle& tri = mesh.Triangles[static_cast<std::size_t>(t)];
+    offsets->SetValue(t, 3 * t);
+    connectivity->SetValue(3 * t, tri[0]);
+    connectivity->SetValue(3 * t + 1, tri[1]);
+    connectivity->SetValue(3 * t + 2, tri[2]);
+  }
+  offsets->SetValue(numberOfTriangles, 3 * numberOfTriangles);
+  vtkNew<vtkCellArray> polys;
+  polys->SetData(offsets, connectivity);
+
+  output->SetPoints(points);
+  output->SetPolys(polys);
+
+  if (static_cast<vtkIdType>(distance.size()) == numberOfPoints)
+  {
+    vtkNew<vtkDoubleArray> array;
+    array->SetName("DistanceToInput");
+    array->SetNumberOfValues(numberOfPoints);
+    for (vtkIdType i = 0; i < numberOfPoints; ++i)
+    {
+      array->SetValue(i, distance[static_cast<std::size_t>(i)]);
+    }
+    output->GetPointData()->SetScalars(array);
+  }
+}
+
+void ToImageData(const sdfcage::ScalarImage& field, vtkImageData* output)
+{
+  const auto& dims = field.Dimensions;
+  const std::size_t count =
+    static_cast<std::size_t>(dims[0]) * static_cast<std::size_t>(dims[1]) * dims[2];
+  if (dims[0] <= 0 || dims[1] <= 0 || dims[2] <= 0 || field.Values.size() != count)
+  {
+    return;
+  }
+  output->SetDimensions(dims[0], dims[1], dims[2]);
+  output->SetOrigin(field.Origin[0], field.Origin[1], field.Origin[2]);
+  output->SetSpacing(field.Spacing, field.Spacing, field.Spacing);
+  vtkNew<vtkFloatArray> values;
+  values->SetName("SignedDistance");
+  values->SetNumberOfValues(static_cast<vtkIdType>(count));
+  std::copy(field.Values.begin(), field.Values.end(), values->GetPointer(0));
+  output->GetPointData()->SetScalars(values);
+}
+
+// Machine-readable status identifiers (Core's statusName() is for humans).
+const char* StatusIdentifier(sdfcage::Status status)
+{
+  switch (status)
+  {
+    case sdfcage::Status::Ok:
+      return "Ok";
+    case sdfcage::Status::EmptyInput:
+      return "EmptyInput";
+    case sdfcage::Status::InvalidInput:
+      return "InvalidInput";
+    case sdfcage::Status::Cancelled:
+      return "Cancelled";
+    case sdfcage::Status::VerificationFailed:
+      return "VerificationFailed";
+    case sdfcage::Status::Failed:
+    default:
+      return "Failed";
+  }
+}
+
+template <typename ArrayT, typename ValueT>
+void AddFieldValue(vtkFieldData* fd, const char* name, ValueT value)
+{
+  vtkNew<ArrayT> array;
+  array->SetName(name);
+  array->SetNumberOfTuples(1);
+  array->SetValue(0, value);
+  fd->AddArray(array);
+}
+} // namespace
+
+//------------------------------------------------------------------------------
+vtkSDFCageFilter::vtkSDFCageFilter()
+{
+  // The defaults are Core's, so that the filter, the CLI and the plugin agree.
+  const sdfcage::EnvelopeOptions defaults;
+  this->IsoValue = defaults.IsoValue;
+  this->VoxelSize = defaults.VoxelSize;
+  this->MinimumClearance = defaults.MinimumClearance;
+  this->MaximumRefinements = defaults.MaximumRefinements;
+  this->GenerateDistanceField = defaults.KeepDistanceField ? 1 : 0;
+  this->NumberOfThreads = defaults.NumberOfThreads;
+
+  this->SetNumberOfInputPorts(1);
+  this->SetNumberOfOutputPorts(3);
+  this->ResetResults();
+}
+
+//------------------------------------------------------------------------------
+vtkSDFCageFilter::~vtkSDFCageFilter() = default;
+
+//------------------------------------------------------------------------------
+void vtkSDFCageFilter::ResetResults()
+{
+  this->ValidationTime = 0.0;
+  this->DistanceFieldTime = 0.0;
+  this->IsosurfaceTime = 0.0;
+  this->VerificationTime = 0.0;
+  this->TotalTime = 0.0;
+  this->MeasuredClearance = 0.0;
+  this->MeasuredClearanceRelative = 0.0;
+  this->EnclosureVerified = false;
+  this->RemovedPockets = 0;
+  this->EnvelopeGenus = 0;
+  this->VoxelSizeUsed = 0.0;
+  this->InputWasFlipped = false;
+  this->StatusString = "NotExecuted";
+  this->LastErrorMessage.clear();
+}
+
+//------------------------------------------------------------------------------
+int vtkSDFCageFilter::FillOutputPortInformation(int port, vtkInformation* info)
+{
+  if (port == 2)
+  {
+    info->Set(vtkDataObject::DATA_TYPE_NAME(), "vtkImageData");
+    return 1;
+  }
+  return this->Superclass::FillOutputPortInformation(port, info);
+}
+
+//------------------------------------------------------------------------------
+int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
+  vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  this->ResetResults();
+
+  vtkPolyData* input = vtkPolyData::GetData(inputVector[0], 0);
+  vtkPolyData* cageOutput = vtkPolyData::GetData(outputVector, 0);
+  vtkPolyData* envelopeOutput = vtkPolyData::GetData(outputVector, 1);
+  vtkImageData* fieldOutput = vtkImageData::GetData(outputVector, 2);
+  if (!cageOutput || !envelopeOutput || !fieldOutput)
+  {
+    vtkErrorMacro("Output data objects are missing or of the wrong type.");
+    return 0;
+  }
+  cageOutput->Initialize();
+  envelopeOutput->Initialize();
+  fieldOutput->Initialize();
+
+  // Publishes the results as field data on the cage (for ParaView's Information panel and
+  // pvpython's Fetch), whatever the outcome.
+  auto publish = [&]() {
+    vtkFieldData* fd = cageOutput->GetFieldData();
+    AddFieldValue<vtkDoubleArray>(fd, "ValidationTime", this->ValidationTime);
+    AddFieldValue<vtkDoubleArray>(fd, "DistanceFieldTime", this->DistanceFieldTime);
+    AddFieldValue<vtkDoubleArray>(fd, "IsosurfaceTime", this->IsosurfaceTime);
+    AddFieldValue<vtkDoubleArray>(fd, "VerificationTime", this->VerificationTime);
+    AddFieldValue<vtkDoubleArray>(fd, "TotalTime", this->TotalTime);
+    AddFieldValue<vtkDoubleArray>(fd, "MeasuredClearance", this->MeasuredClearance);
+    AddFieldValue<vtkDoubleArray>(
+      fd, "MeasuredClearanceRelative", this->MeasuredClearanceRelative);
+    AddFieldValue<vtkIntArray>(fd, "EnclosureVerified", this->EnclosureVerified ? 1 : 0);
+    AddFieldValue<vtkIntArray>(fd, "RemovedPockets", this->RemovedPockets);
+    AddFieldValue<vtkIntArray>(fd, "EnvelopeGenus", this->EnvelopeGenus);
+    AddFieldValue<vtkDoubleArray>(fd, "VoxelSizeUsed", this->VoxelSizeUsed);
+    AddFieldValue<vtkIntArray>(fd, "InputWasFlipped", this->InputWasFlipped ? 1 : 0);
+    AddFieldValue<vtkStringArray>(fd, "Status", this->StatusString);
+    AddFieldValue<vtkStringArray>(fd, "LastErrorMessage", this->LastErrorMessage);
+  };
+  auto fail = [&](const std::string& status, const std::string& message) {
+    this->StatusString = status;
+    this->LastErrorMessage = message;
+    vtkErrorMacro(<< message);
+    publish();
+    return 0;
+  };
+
+  // Empty input is not an error.
+  if (!input || input->GetNumberOfPoints() == 0 || input->GetNumberOfCells() == 0)
+  {
+    this->StatusString = StatusIdentifier(sdfcage::Status::EmptyInput);
+    publish();
+    return 1;
+  }
+  if (input->GetNumberOfPolys() + input->GetNumberOfStrips() == 0)
+  {
+    std::ostringstream msg;
+    msg << "The input has " << input->GetNumberOfVerts() << " vertex and "
+        << input->GetNumberOfLines()
+        << " line cells but no polygons: a closed surface mesh is required (for a point cloud, "
+           "reconstruct a surface first, e.g. with vtkSurfaceReconstructionFilter).";
+    return fail(StatusIdentifier(sdfcage::Status::InvalidInput), msg.str());
+  }
+
+  try
+  {
+    sdfcage::PolygonMesh mesh;
+    ToPolygonMesh(input, mesh);
+
+    sdfcage::CageOptions options;
+    options.Envelope.IsoValue = this->IsoValue;
+    options.Envelope.VoxelSize = this->VoxelSize;
+    options.Envelope.MinimumClearance = this->MinimumClearance;
+    options.Envelope.MaximumRefinements = this->MaximumRefinements;
+    options.Envelope.KeepDistanceField = this->GenerateDistanceField != 0;
+    options.Envelope.NumberOfThreads = this->NumberOfThreads;
+
+    FilterProgress progress(this);
+    this->UpdateProgress(0.0);
+    const sdfcage::CageResult result = sdfcage::generateCage(mesh, options, &progress);
+
+    this->ValidationTime = result.ValidationSeconds;
+    this->DistanceFieldTime = result.DistanceFieldSeconds;
+    this->IsosurfaceTime = result.IsosurfaceSeconds;
+    this->VerificationTime = result.VerificationSeconds;
+    this->TotalTime = result.TotalSeconds;
+    this->MeasuredClearance = result.MinimumClearance;
+    this->MeasuredClearanceRelative = result.MinimumClearanceRelative;
+    this->EnclosureVerified = result.EnclosureVerified;
+    this->RemovedPockets = result.RemovedPockets;
+    this->EnvelopeGenus = result.EnvelopeGenus;
+    this->VoxelSizeUsed = result.VoxelSizeUsed;
+    this->InputWasFlipped = result.Defects.FlippedOrientation;
+    this->StatusString = StatusIdentifier(result.State);
+    this->LastErrorMessage = result.Message;
+
+    switch (result.State)
+    {
+      case sdfcage::Status::Ok:
+        break;
+      case sdfcage::Status::EmptyInput:
+        // e.g. every polygon was a vertex or line cell: nothing to enclose, not an error.
+        publish();
+        return 1;
+      case sdfcage::Status::Cancelled:
+        // Aborted by the user: empty outputs, no error.
+        vtkDebugMacro("Execution cancelled: " << result.Message);
+        publish();
+        return 1;
+      case sdfcage::Status::InvalidInput:
+      {
+        std::string message = result.Message;
+        if (message.empty())
+        {
+          message = result.Defects.errorMessage();
+        }
+        return fail(this->StatusString, "Invalid input: " + message);
+      }
+      case sdfcage::Status::VerificationFailed:
+        // Keep the unverified envelope for inspection; the cage stays empty.
+        ToPolyData(result.Envelope, result.EnvelopeDistanceToInput, envelopeOutput);
+        return fail(this->StatusString,
+          "The envelope could not be verified: " +
+            (result.Message.empty() ? std::string("no reason given") : result.Message));
+      case sdfcage::Status::Failed:
+      default:
+        return fail(this->StatusString,
+          "Cage generation failed: " +
+            (result.Message.empty() ? std::string("no reason given") : result.Message));
+    }
+
+    const std::vector<std::string> warnings = result.Defects.warnings();
+    if (!warnings.empty())
+    {
+      std::ostringstream msg;
+      for (std::size_t i = 0; i < warnings.size(); ++i)
+      {
+        msg << (i ? "; " : "") << warnings[i];
+      }
+      vtkWarningMacro(<< msg.str());
+    }
+
+    ToPolyData(result.Cage, result.CageDistanceToInput, cageOutput);
+    ToPolyData(result.Envelope, result.EnvelopeDistanceToInput, envelopeOutput);
+    if (this->GenerateDistanceField)
+    {
+      ToImageData(result.DistanceField, fieldOutput);
+    }
+    publish();
+    this->UpdateProgress(1.0);
+    return 1;
+  }
+  catch (const std::bad_alloc&)
+  {
+    cageOutput->Initialize();
+    envelopeOutput->Initialize();
+    fieldOutput->Initialize();
+    return fail(StatusIdentifier(sdfcage::Status::Failed),
+      "Out of memory. Use a larger VoxelSize (or IsoValue), or turn GenerateDistanceField off.");
+  }
+  catch (const std::exception& e)
+  {
+    cageOutput->Initialize();
+    envelopeOutput->Initialize();
+    fieldOutput->Initialize();
+    return fail(StatusIdentifier(sdfcage::Status::Failed), std::string("Cage generation failed: ") + e.what());
+  }
+  catch (...)
+  {
+    cageOutput->Initialize();
+    envelopeOutput->Initialize();
+    fieldOutput->Initialize();
+    return fail(StatusIdentifier(sdfcage::Status::Failed), "Cage generation failed with an unknown exception.");
+  }
+}
+
+//------------------------------------------------------------------------------
+void vtkSDFCageFilter::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "IsoValue: " << this->IsoValue << "\n";
+  os << indent << "VoxelSize: " << this->VoxelSize << "\n";
+  os << indent << "MinimumClearance: " << this->MinimumClearance << "\n";
+  os << indent << "MaximumRefinements: " << this->MaximumRefinements << "\n";
+  os << indent << "GenerateDistanceField: " << (this->GenerateDistanceField ? "On" : "Off")
+     << "\n";
+  os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";
+  os << indent << "Status: " << this->StatusString << "\n";
+  os << indent << "LastErrorMessage: " << this->LastErrorMessage << "\n";
+  os << indent << "ValidationTime: " << this->ValidationTime << "\n";
+  os << indent << "DistanceFieldTime: " << this->DistanceFieldTime << "\n";
+  os << indent << "IsosurfaceTime: " << this->IsosurfaceTime << "\n";
+  os << indent << "VerificationTime: " << this->VerificationTime << "\n";
+  os << indent << "TotalTime: " << this->TotalTime << "\n";
+  os << indent << "MeasuredClearance: " << this->MeasuredClearance << "\n";
+  os << indent << "MeasuredClearanceRelative: " << this->MeasuredClearanceRelative << "\n";
+  os << indent << "EnclosureVerified: " << this->EnclosureVerified << "\n";
+  os << indent << "RemovedPockets: " << this->RemovedPockets << "\n";
+  os << indent << "EnvelopeGenus: " << this->EnvelopeGenus << "\n";
+  os << indent << "VoxelSizeUsed: " << this->VoxelSizeUsed << "\n";
+  os << indent << "InputWasFlipped: " << this->InputWasFlipped << "\n";
+}
