@@ -35,6 +35,11 @@ using T3 = K::Triangle_3;
 using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, int,
   CGAL::Box_intersection_d::ID_EXPLICIT>;
 
+/// box_intersection_d switches to brute-force scanning below this many boxes. CGAL's default is
+/// 10; on surface meshes of 10^5..10^6 small triangles 2000 was ~1.5x faster (armadillo, 346k
+/// cage triangles vs 86k input triangles: 3.8 s instead of 5.3 s CPU for the whole check).
+constexpr std::ptrdiff_t kBoxCutoff = 2000;
+
 /// A triangle as a point set: a proper triangle (Size 3), or, when degenerate, the segment
 /// (Size 2) or point (Size 1) it collapses to. Size 0: unusable (bad id or non-finite point).
 struct Primitive
@@ -449,76 +454,137 @@ void checkTopology(const TriangleMesh& cage, const std::vector<char>& valid, Exa
   }
 }
 
-/// Counts referenced, finite input vertices not strictly inside the closed cage.
-long long countOutside(const TriangleMesh& input, const TriangleMesh& cage, const std::vector<char>& cageValid, bool cageUsable)
+/// Counts the referenced input vertices that are not strictly inside the closed cage
+/// (non-finite ones count as outside). `cageUsable`: the cage is a closed manifold without
+/// degenerate triangles (otherwise inside is unknown and every vertex counts as outside).
+/// `oneQueryPerComponent`: no cage triangle touches any input triangle, so each connected input
+/// component lies in a single cell of the cage's complement and one exact query per component
+/// decides for all of its vertices.
+long long countOutside(const TriangleMesh& input, const TriangleMesh& cage,
+  const std::vector<char>& cageValid, bool cageUsable, bool consistentOrientation,
+  bool oneQueryPerComponent)
 {
+  const int nInput = static_cast<int>(input.Points.size());
   std::vector<char> referenced(input.Points.size(), 0);
+  UnionFind components(input.Points.size());
   long long total = 0;
-  for (std::size_t t = 0; t < input.Triangles.size(); ++t)
+  for (const Triangle& tri : input.Triangles)
   {
-    const Triangle& tri = input.Triangles[t];
+    bool valid = true;
     for (int k = 0; k < 3; ++k)
     {
       const int v = tri[k];
-      if (v >= 0 && v < static_cast<int>(input.Points.size()) && !referenced[v])
+      if (v < 0 || v >= nInput)
+      {
+        valid = false;
+        continue;
+      }
+      valid = valid && finite(input.Points[v]); // only geometric triangles connect vertices
+      if (!referenced[v])
       {
         referenced[v] = 1;
         ++total;
       }
+    }
+    if (valid)
+    {
+      components.unite(tri[0], tri[1]);
+      components.unite(tri[1], tri[2]);
     }
   }
   if (!cageUsable)
   {
     return total;
   }
+
   using Mesh = CGAL::Surface_mesh<P3>;
   namespace PMP = CGAL::Polygon_mesh_processing;
-  std::vector<P3> points;
-  points.reserve(cage.Points.size());
-  for (const Vec3& x : cage.Points)
+  Mesh mesh;
+  if (consistentOrientation)
   {
-    points.emplace_back(x[0], x[1], x[2]);
-  }
-  std::vector<std::array<std::size_t, 3>> polygons;
-  polygons.reserve(cage.Triangles.size());
-  for (std::size_t t = 0; t < cage.Triangles.size(); ++t)
-  {
-    if (cageValid[t])
+    // A closed, consistently oriented manifold (checked by id): add it face by face.
+    mesh.reserve(static_cast<Mesh::size_type>(cage.Points.size()),
+      static_cast<Mesh::size_type>(cage.Triangles.size() * 3 / 2),
+      static_cast<Mesh::size_type>(cage.Triangles.size()));
+    for (const Vec3& x : cage.Points)
+    {
+      mesh.add_vertex(P3(x[0], x[1], x[2]));
+    }
+    for (std::size_t t = 0; t < cage.Triangles.size(); ++t)
     {
       const Triangle& tri = cage.Triangles[t];
-      polygons.push_back({ static_cast<std::size_t>(tri[0]), static_cast<std::size_t>(tri[1]),
-        static_cast<std::size_t>(tri[2]) });
+      if (cageValid[t] && mesh.add_face(Mesh::Vertex_index(tri[0]), Mesh::Vertex_index(tri[1]),
+                            Mesh::Vertex_index(tri[2])) == Mesh::null_face())
+      {
+        return total;
+      }
     }
   }
-  // Side_of_triangle_mesh counts ray crossings, so orientation does not matter; a halfedge mesh
-  // needs consistent orientation though, which orient_polygon_soup provides if possible.
-  if (!PMP::is_polygon_soup_a_polygon_mesh(polygons))
+  else
   {
+    // Side_of_triangle_mesh counts ray crossings, so orientation does not matter, but a halfedge
+    // mesh needs a consistent one: orient the soup (fails for a non-orientable cage).
+    std::vector<P3> points;
+    points.reserve(cage.Points.size());
+    for (const Vec3& x : cage.Points)
+    {
+      points.emplace_back(x[0], x[1], x[2]);
+    }
+    std::vector<std::array<std::size_t, 3>> polygons;
+    for (std::size_t t = 0; t < cage.Triangles.size(); ++t)
+    {
+      if (cageValid[t])
+      {
+        const Triangle& tri = cage.Triangles[t];
+        polygons.push_back({ static_cast<std::size_t>(tri[0]), static_cast<std::size_t>(tri[1]),
+          static_cast<std::size_t>(tri[2]) });
+      }
+    }
     PMP::orient_polygon_soup(points, polygons);
     if (!PMP::is_polygon_soup_a_polygon_mesh(polygons))
     {
       return total;
     }
+    PMP::polygon_soup_to_polygon_mesh(points, polygons, mesh);
   }
-  Mesh mesh;
-  PMP::polygon_soup_to_polygon_mesh(points, polygons, mesh);
   if (mesh.number_of_faces() == 0 || !CGAL::is_closed(mesh) || !CGAL::is_triangle_mesh(mesh))
   {
     return total;
   }
+
   CGAL::Side_of_triangle_mesh<Mesh, K> side(mesh);
+  auto outsideOf = [&](int v) {
+    const Vec3& x = input.Points[v];
+    return !finite(x) || side(P3(x[0], x[1], x[2])) != CGAL::ON_BOUNDED_SIDE;
+  };
   long long outside = 0;
-  for (std::size_t v = 0; v < input.Points.size(); ++v)
+  if (!oneQueryPerComponent)
+  {
+    for (int v = 0; v < nInput; ++v)
+    {
+      outside += (referenced[v] && outsideOf(v)) ? 1 : 0;
+    }
+    return outside;
+  }
+  // Query one finite vertex per component; non-finite vertices always count.
+  std::vector<signed char> verdict(input.Points.size(), -1); // per component root
+  for (int v = 0; v < nInput; ++v)
   {
     if (!referenced[v])
     {
       continue;
     }
-    const Vec3& x = input.Points[v];
-    if (!finite(x) || side(P3(x[0], x[1], x[2])) != CGAL::ON_BOUNDED_SIDE)
+    if (!finite(input.Points[v]))
     {
       ++outside;
+      continue;
     }
+    signed char& c = verdict[components.find(v)];
+    if (c < 0)
+    {
+      c = outsideOf(v) ? 1 : 0;
+    }
+    outside += c;
   }
   return outside;
 }
@@ -565,10 +631,19 @@ ExactReport exactCheck(const TriangleMesh& input, const TriangleMesh& cage, doub
     }
   }
 
+  auto lap = [last = start]() mutable {
+    const auto now = std::chrono::steady_clock::now();
+    const double s = std::chrono::duration<double>(now - last).count();
+    last = now;
+    return s;
+  };
+
   // --- topology ---
   checkTopology(cage, cageValid, report);
   report.Closed2Manifold = !cage.Triangles.empty() && report.InvalidTriangles == 0 &&
     report.BoundaryEdges == 0 && report.NonManifoldEdges == 0 && report.NonManifoldVertices == 0;
+
+  report.PhaseSeconds[0] = lap();
 
   // --- self-intersections ---
   report.SelfIntersections = report.DegenerateTriangles;
@@ -592,9 +667,11 @@ ExactReport exactCheck(const TriangleMesh& input, const TriangleMesh& cage, doub
       const bool hit = shared == 0 ? CGAL::do_intersect(a.triangle(), b.triangle())
                                    : adjacentIntersect(ta, tb, a, b, shared);
       count += hit ? 1 : 0;
-    });
+    }, CGAL::Box_intersection_d::Box_traits_d<Box>(), kBoxCutoff);
     report.SelfIntersections += count;
   }
+
+  report.PhaseSeconds[1] = lap();
 
   // --- cage/input intersections and clearance ---
   double limit = clearanceQueryLimit;
@@ -655,15 +732,20 @@ ExactReport exactCheck(const TriangleMesh& input, const TriangleMesh& cage, doub
           best2 = d2;
           found = true;
         }
-      });
+      }, CGAL::Box_intersection_d::Box_traits_d<Box>(), kBoxCutoff);
     report.InputIntersections = hits;
     report.ClearanceIsLowerBound = !found;
     report.MinimumClearance = found ? std::sqrt(best2) : limit;
   }
 
+  report.PhaseSeconds[2] = lap();
+
   // --- input vertices strictly inside ---
   report.InputVerticesOutside = countOutside(input, cage, cageValid,
-    report.Closed2Manifold && report.DegenerateTriangles == 0);
+    report.Closed2Manifold && report.DegenerateTriangles == 0, report.InconsistentEdges == 0,
+    report.InputIntersections == 0);
+
+  report.PhaseSeconds[3] = lap();
 
   report.Encloses = report.Closed2Manifold && report.SelfIntersections == 0 &&
     report.InputIntersections == 0 && report.InputVerticesOutside == 0;
@@ -682,12 +764,13 @@ std::string toJson(const ExactReport& r)
     "\"ClearanceIsLowerBound\": %s, \"CageGenus\": %d, \"CageComponents\": %d, "
     "\"Encloses\": %s, \"DegenerateTriangles\": %lld, \"InconsistentEdges\": %lld, "
     "\"InvalidTriangles\": %lld, \"CageTriangles\": %lld, \"InputTriangles\": %lld, "
-    "\"ClearanceQueryLimit\": %.17g, \"Seconds\": %.6f}",
+    "\"ClearanceQueryLimit\": %.17g, \"Seconds\": %.6f, \"PhaseSeconds\": [%.6f, %.6f, %.6f, %.6f]}",
     r.BoundaryEdges, r.NonManifoldEdges, r.NonManifoldVertices, r.Closed2Manifold ? "true" : "false",
     r.SelfIntersections, r.InputIntersections, r.InputVerticesOutside, r.MinimumClearance,
     r.ClearanceIsLowerBound ? "true" : "false", r.CageGenus, r.CageComponents,
     r.Encloses ? "true" : "false", r.DegenerateTriangles, r.InconsistentEdges, r.InvalidTriangles,
-    r.CageTriangles, r.InputTriangles, r.ClearanceQueryLimit, r.Seconds);
+    r.CageTriangles, r.InputTriangles, r.ClearanceQueryLimit, r.Seconds, r.PhaseSeconds[0],
+    r.PhaseSeconds[1], r.PhaseSeconds[2], r.PhaseSeconds[3]);
   return buffer;
 }
 

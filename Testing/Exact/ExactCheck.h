@@ -59,6 +59,8 @@ struct ExactReport
   long long InputTriangles = 0;
   double ClearanceQueryLimit = 0.0; ///< the limit actually used
   double Seconds = 0.0;             ///< wall time of exactCheck
+  /// Wall time of its phases: topology, self-intersections, cage/input pairs, inside test.
+  double PhaseSeconds[4] = { 0.0, 0.0, 0.0, 0.0 };
 };
 
 /// Checks that `cage` strictly encloses `input` (both in the same coordinates). Distances up to

@@ -134,6 +134,19 @@ TEST(ExactCheck, InnerCageLeavesAllInputVerticesOutside)
   EXPECT_FALSE(r.Encloses);
 }
 
+TEST(ExactCheck, InputComponentOutsideCountsAllItsVertices)
+{
+  // No cage/input contact: one inside query per input component decides for all its vertices.
+  TriangleMesh input = cube(1.0);
+  append(input, box(Vec3(5, 5, 5), Vec3(6, 6, 6)));
+  append(input, box(Vec3(-0.5, -0.5, 1.5), Vec3(0.5, 0.5, 1.9)));
+  const ExactReport r = exactCheck(input, cube(2.0), 5.0);
+  EXPECT_EQ(r.InputIntersections, 0);
+  EXPECT_EQ(r.InputVerticesOutside, 8);
+  EXPECT_NEAR(r.MinimumClearance, 0.1, 1e-12); // z = 1.9 vs the cage face z = 2
+  EXPECT_FALSE(r.Encloses);
+}
+
 TEST(ExactCheck, TouchingFaceIsAnIntersection)
 {
   // Input box [-1, 2] x [-1, 1]^2 touches the cage face x = 2.
