@@ -11,6 +11,7 @@
 #include <chrono>
 #include <cmath>
 #include <mutex>
+#include <cstdlib>
 
 namespace sdfcage
 {
@@ -56,7 +57,7 @@ std::once_flag vdbInit;
 } // namespace
 
 IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSize, double iso,
-  bool keepField, Progress* progress)
+  bool keepField, Progress* progress, double adaptivity)
 {
   std::call_once(vdbInit, []() { openvdb::initialize(); });
   IsosurfaceOutput out;
@@ -78,10 +79,12 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
   openvdb::tools::QuadAndTriangleDataAdapter<openvdb::Vec3s, openvdb::Vec3I> adapter(points, tris);
   auto transform = openvdb::math::Transform::createLinearTransform(voxelSize);
 
-  // The isosurface at `iso` needs exact values up to iso, plus one voxel for interpolation and one
-  // of margin. Inside, one voxel band is enough: the flood fill gives the interior its sign.
-  const float exteriorBand = static_cast<float>(std::ceil(iso / voxelSize) + 2.0);
-  const float interiorBand = 2.0f;
+  // The isosurface at `iso` needs values up to iso plus one voxel. Corners beyond the band read the
+  // background (band width), which is still > iso: the crossing can only move outward (the safe
+  // side), and the envelope is verified anyway. Inside, one voxel is enough: the flood fill gives
+  // the interior its sign. Narrow bands are most of the speed of this stage.
+  const float exteriorBand = static_cast<float>(std::ceil(iso / voxelSize) + 1.0);
+  const float interiorBand = 1.0f;
   VdbInterrupter sdfInterrupter(progress, 0.0, 0.6);
   openvdb::FloatGrid::Ptr grid;
   try
@@ -108,7 +111,7 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
   std::vector<openvdb::Vec4I> meshQuads;
   try
   {
-    openvdb::tools::volumeToMesh(*grid, meshPoints, meshTris, meshQuads, iso, 0.0, true);
+    openvdb::tools::volumeToMesh(*grid, meshPoints, meshTris, meshQuads, iso, adaptivity, true);
   }
   catch (const std::exception& e)
   {

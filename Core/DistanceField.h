@@ -27,6 +27,6 @@ struct IsosurfaceOutput
 /// fill), wide enough outside for `iso`, then marching-cubes-style extraction at `iso`.
 /// Progress: fractions 0..0.6 for the SDF, 0.6..1 for the surface of the current stage.
 IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSize, double iso,
-  bool keepField, Progress* progress);
+  bool keepField, Progress* progress, double adaptivity = 0.0);
 
 } // namespace sdfcage

@@ -288,7 +288,7 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
   for (int attempt = 0; attempt <= std::max(0, options.MaximumRefinements); ++attempt, h *= 0.5)
   {
     progressStage(progress, "distance field and isosurface", 0.02, 0.7);
-    IsosurfaceOutput iso = computeIsosurface(unitInput, h, c, options.KeepDistanceField, progress);
+    IsosurfaceOutput iso = computeIsosurface(unitInput, h, c, options.KeepDistanceField, progress, options.Adaptivity);
     result.DistanceFieldSeconds += iso.DistanceFieldSeconds;
     result.IsosurfaceSeconds += iso.IsosurfaceSeconds;
     if (iso.Cancelled)

@@ -23,6 +23,11 @@ struct EnvelopeOptions
   /// Clearance delta that every envelope triangle must keep from every input triangle;
   /// 0 = automatic (IsoValue / 4).
   double MinimumClearance = 0.0;
+  /// OpenVDB volumeToMesh adaptivity (0 = uniform triangles; up to 1 merges flat regions into
+  /// larger polygons, giving a smaller envelope that is verified like any other). The default
+  /// 0.1 gives about 5x fewer triangles than 0 with the same clearance (about c/2) on the shared
+  /// test meshes, which makes verification and simplification correspondingly faster.
+  double Adaptivity = 0.1;
   /// If verification fails, retry up to this many times with half the voxel size.
   int MaximumRefinements = 2;
   /// Keep the sampled SDF as a dense image (for display).

@@ -141,6 +141,16 @@ bool TriangleIndex::closestPoint(const Vec3& p, double maxDistance, Vec3& closes
           {
             const int f = CellTriangles[s];
             const Triangle& t = Mesh->Triangles[f];
+            {
+              // cheap box test first: skip triangles whose box is farther than the best so far
+              const Vec3& a = Mesh->Points[t[0]];
+              const Vec3& b = Mesh->Points[t[1]];
+              const Vec3& cc = Mesh->Points[t[2]];
+              const Vec3 tlo = a.cwiseMin(b).cwiseMin(cc), thi = a.cwiseMax(b).cwiseMax(cc);
+              const Vec3 bd = (tlo - p).cwiseMax(p - thi).cwiseMax(0.0);
+              if (bd.squaredNorm() > best2)
+                continue;
+            }
             const Vec3 q = closestPointOnTriangle(p, Mesh->Points[t[0]], Mesh->Points[t[1]], Mesh->Points[t[2]]);
             const double d2 = (q - p).squaredNorm();
             if (d2 < best2 || (triangle < 0 && d2 <= best2))
