@@ -436,7 +436,7 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
         {
           message = result.Defects.errorMessage();
         }
-        return fail(this->StatusString, "Invalid input: " + message);
+        return fail(this->StatusString, message);
       }
       case sdfcage::Status::VerificationFailed:
         // Keep the unverified envelope for inspection; the cage stays empty.

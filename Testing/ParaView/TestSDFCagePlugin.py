@@ -1,0 +1,116 @@
+"""SDFCage: the ParaView plugin under pvbatch.
+
+Run: pvbatch TestSDFCagePlugin.py <path to SDFCage.so> <scratch dir> [data dir]
+Loads the plugin, runs the "SDF Cage" proxy on a Sphere source, fetches the outputs, and checks
+the OFF reader/writer proxies.
+"""
+import os
+import sys
+
+from paraview.simple import *  # noqa: F401,F403
+from paraview import servermanager
+
+plugin, scratch = sys.argv[1], sys.argv[2]
+data_dir = sys.argv[3] if len(sys.argv) > 3 else ""
+failures = []
+
+
+def check(condition, message):
+    print(("ok:   " if condition else "FAIL: ") + message)
+    if not condition:
+        failures.append(message)
+
+
+LoadPlugin(plugin, remote=False, ns=globals())
+check("SDFCage" in globals(), "the plugin defines SDFCage()")
+check("OFFMeshReader" in globals(), "the plugin defines OFFMeshReader()")
+
+# --- the filter ------------------------------------------------------------------------------
+sphere = Sphere(Radius=2.0, ThetaResolution=32, PhiResolution=32)
+cage = SDFCage(Input=sphere)
+check(cage.IsoValue == 0.01, "IsoValue default 0.01")
+cage.IsoValue = 0.04  # coarse: keeps the dense distance image small
+cage.GenerateDistanceField = 1
+cage.UpdatePipeline()
+
+out = servermanager.Fetch(cage)
+check(out is not None and out.IsA("vtkPolyData"), "port 0 fetches a vtkPolyData")
+check(out.GetNumberOfPoints() > 0 and out.GetNumberOfPolys() > 0,
+      "non-empty cage (%d points)" % out.GetNumberOfPoints())
+dist = out.GetPointData().GetArray("DistanceToInput")
+check(dist is not None, "DistanceToInput on the cage")
+status = out.GetFieldData().GetAbstractArray("Status")
+check(status is not None and status.GetValue(0) == "Ok", "field data Status = Ok")
+clearance = out.GetFieldData().GetArray("MeasuredClearance").GetValue(0)
+if dist is not None:
+    check(dist.GetRange()[0] >= clearance * (1 - 1e-9), "DistanceToInput >= MeasuredClearance")
+check(out.GetFieldData().GetArray("EnclosureVerified").GetValue(0) == 1, "EnclosureVerified")
+
+envelope = servermanager.Fetch(cage, idx=1)
+check(envelope.GetNumberOfPoints() > 0, "port 1 (Envelope) is not empty")
+field = servermanager.Fetch(cage, idx=2)
+check(field.IsA("vtkImageData") and field.GetNumberOfPoints() > 0,
+      "port 2 (Distance Field) is a non-empty vtkImageData")
+check(field.GetPointData().GetArray("SignedDistance") is not None, "SignedDistance array")
+
+cage.UpdatePropertyInformation()
+check(cage.GetProperty("StatusInfo").GetElement(0) == "Ok", "information property StatusInfo")
+check(cage.GetProperty("TotalTimeInfo").GetElement(0) > 0, "information property TotalTimeInfo")
+
+info = cage.GetDataInformation(0)
+check(info.GetNumberOfPoints() == out.GetNumberOfPoints(), "data information agrees with Fetch")
+
+# --- an open input: error, empty output, no crash ----------------------------------------------
+plane = Plane(XResolution=4, YResolution=4)  # an open sheet: 16 boundary edges
+bad = SDFCage(Input=plane)
+# Capture the expected error (and the executive's "returned failure") with observers on the
+# server-side objects (builtin session), so that nothing reaches the output window.
+captured = []
+
+
+def on_error(caller, event, calldata=None):
+    captured.append(str(calldata))
+
+
+from vtkmodules.vtkCommonCore import VTK_STRING  # noqa: E402
+on_error.CallDataType = VTK_STRING  # pass the message to the observer
+bad_object = bad.GetClientSideObject()
+bad_object.AddObserver("ErrorEvent", on_error)
+bad_object.GetExecutive().AddObserver("ErrorEvent", on_error)
+bad.UpdatePipeline()
+check(any("boundary" in m for m in captured), "open input: an error event names boundary edges")
+bad_out = servermanager.Fetch(bad)
+check(bad_out.GetNumberOfPoints() == 0, "open input gives an empty cage")
+bad.UpdatePropertyInformation()
+check(bad.GetProperty("StatusInfo").GetElement(0) == "InvalidInput", "open input: InvalidInput")
+message = bad.GetProperty("LastErrorMessageInfo").GetElement(0)
+print("error message:", message)
+check("boundary" in message, "open input: the message names boundary edges")
+
+# --- OFF writer and reader proxies -------------------------------------------------------------
+path = os.path.join(scratch, "pv_sphere.off")
+if os.path.exists(path):
+    os.remove(path)
+SaveData(path, proxy=cage)
+check(os.path.exists(path), "SaveData wrote %s through the OFF writer" % path)
+reader = OpenDataFile(path)
+check(reader is not None and reader.GetXMLName() == "OFFMeshReader",
+      "OpenDataFile picks the OFF Mesh Reader for .off (%s)" % (reader.GetXMLName() if reader else None))
+if reader is not None:
+    back = servermanager.Fetch(reader)
+    check(back.GetNumberOfPoints() == out.GetNumberOfPoints()
+          and back.GetNumberOfPolys() == out.GetNumberOfPolys(), "the cage reads back identically")
+
+knight = os.path.join(data_dir, "decimated-knight.off") if data_dir else ""
+if knight and os.path.exists(knight):
+    k = OFFMeshReader(FileName=knight)
+    kc = SDFCage(Input=k)
+    kd = servermanager.Fetch(kc)
+    check(kd.GetNumberOfPoints() > 0, "the knight from the data folder gets a cage")
+else:
+    print("skip: data folder absent, no knight")
+
+if failures:
+    print("%d failure(s)" % len(failures))
+    sys.exit(1)
+print("plugin test passed")
