@@ -1,0 +1,183 @@
+// SDFCage — CLI: see CLIReport.h.
+#include "CLIReport.h"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+namespace sdfcage_cli
+{
+
+namespace
+{
+
+std::string jsonString(const std::string& s)
+{
+  std::string out = "\"";
+  for (const char ch : s)
+  {
+    const unsigned char c = static_cast<unsigned char>(ch);
+    switch (c)
+    {
+      case '"':
+        out += "\\\"";
+        break;
+      case '\\':
+        out += "\\\\";
+        break;
+      case '\n':
+        out += "\\n";
+        break;
+      case '\r':
+        out += "\\r";
+        break;
+      case '\t':
+        out += "\\t";
+        break;
+      default:
+        if (c < 0x20)
+        {
+          char buffer[8];
+          std::snprintf(buffer, sizeof(buffer), "\\u%04x", c);
+          out += buffer;
+        }
+        else
+        {
+          out += ch;
+        }
+    }
+  }
+  return out + "\"";
+}
+
+std::string jsonNumber(double v)
+{
+  if (!std::isfinite(v))
+  {
+    return "null"; // JSON has no NaN/Inf
+  }
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.10g", v);
+  return buffer;
+}
+
+std::string seconds(double s)
+{
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.2f s", s);
+  return buffer;
+}
+
+std::string number(double v)
+{
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.4g", v);
+  return buffer;
+}
+
+} // namespace
+
+std::string toJson(const RunReport& r)
+{
+  std::ostringstream os;
+  bool first = true;
+  auto key = [&](const char* name) -> std::ostream& {
+    os << (first ? "\n" : ",\n") << "  " << jsonString(name) << ": ";
+    first = false;
+    return os;
+  };
+  os << "{";
+  key("InputFile") << jsonString(r.InputFile);
+  key("OutputFile") << jsonString(r.OutputFile);
+  key("ScreenshotFile") << jsonString(r.ScreenshotFile);
+  key("Status") << jsonString(r.Status);
+  key("ErrorMessage") << jsonString(r.ErrorMessage);
+  key("ExitCode") << r.ExitCode;
+  key("IsoValue") << jsonNumber(r.IsoValue);
+  key("VoxelSize") << jsonNumber(r.VoxelSize);
+  key("MinimumClearance") << jsonNumber(r.MinimumClearance);
+  key("MinimumClearanceUsed") << jsonNumber(r.MinimumClearanceUsed);
+  key("NumberOfThreads") << r.NumberOfThreads;
+  key("InputPoints") << r.InputPoints;
+  key("InputCells") << r.InputCells;
+  key("InputTriangles") << r.InputTriangles;
+  key("EnvelopePoints") << r.EnvelopePoints;
+  key("EnvelopeTriangles") << r.EnvelopeTriangles;
+  key("CagePoints") << r.CagePoints;
+  key("CageTriangles") << r.CageTriangles;
+  key("ReadTime") << jsonNumber(r.ReadTime);
+  key("ValidationTime") << jsonNumber(r.ValidationTime);
+  key("DistanceFieldTime") << jsonNumber(r.DistanceFieldTime);
+  key("IsosurfaceTime") << jsonNumber(r.IsosurfaceTime);
+  key("VerificationTime") << jsonNumber(r.VerificationTime);
+  key("TotalTime") << jsonNumber(r.TotalTime);
+  key("WriteTime") << jsonNumber(r.WriteTime);
+  key("MeasuredClearance") << jsonNumber(r.MeasuredClearance);
+  key("MeasuredClearanceRelative") << jsonNumber(r.MeasuredClearanceRelative);
+  key("EnclosureVerified") << (r.EnclosureVerified ? "true" : "false");
+  key("RemovedPockets") << r.RemovedPockets;
+  key("EnvelopeGenus") << r.EnvelopeGenus;
+  key("VoxelSizeUsed") << jsonNumber(r.VoxelSizeUsed);
+  key("InputWasFlipped") << (r.InputWasFlipped ? "true" : "false");
+  os << "\n}\n";
+  return os.str();
+}
+
+bool writeJsonReport(const RunReport& r, const std::string& path, std::string& error)
+{
+  std::ofstream file(path, std::ios::out | std::ios::trunc);
+  if (!file)
+  {
+    error = "cannot write the report '" + path + "': check that the folder exists and is writable";
+    return false;
+  }
+  file << toJson(r);
+  file.close();
+  if (!file)
+  {
+    error = "cannot write the report '" + path + "': write error";
+    return false;
+  }
+  return true;
+}
+
+void printSummary(std::ostream& os, const RunReport& r)
+{
+  os << "input       : " << (r.InputFile == "builtin" ? "built-in shape" : r.InputFile) << ", "
+     << r.InputPoints << " points, " << r.InputTriangles << " triangles";
+  if (r.InputCells != r.InputTriangles)
+  {
+    os << " (from " << r.InputCells << " polygons)";
+  }
+  if (r.InputWasFlipped)
+  {
+    os << ", inward-oriented (flipped)";
+  }
+  os << "\n";
+  if (!r.FilterRan)
+  {
+    return;
+  }
+  os << "envelope    : " << r.EnvelopePoints << " points, " << r.EnvelopeTriangles
+     << " triangles, genus " << r.EnvelopeGenus << ", " << r.RemovedPockets
+     << " trapped pocket(s) removed\n";
+  os << "cage        : " << r.CagePoints << " points, " << r.CageTriangles << " triangles";
+  if (!r.OutputFile.empty())
+  {
+    os << " -> " << r.OutputFile;
+  }
+  os << "\n";
+  os << "voxel size  : " << number(r.VoxelSizeUsed) << " (relative: the input scaled into the "
+     << "unit sphere), isovalue " << number(r.IsoValue) << "\n";
+  os << "timings     : validation " << seconds(r.ValidationTime) << ", distance field "
+     << seconds(r.DistanceFieldTime) << ", isosurface " << seconds(r.IsosurfaceTime)
+     << ", verification " << seconds(r.VerificationTime) << ", total " << seconds(r.TotalTime)
+     << "\n";
+  os << "clearance   : " << number(r.MeasuredClearance) << " (input units) = "
+     << number(r.MeasuredClearanceRelative) << " relative, required >= "
+     << number(r.MinimumClearanceUsed) << " relative\n";
+  os << "enclosure verified: " << (r.EnclosureVerified ? "yes" : "no") << "\n";
+}
+
+} // namespace sdfcage_cli

@@ -1,0 +1,66 @@
+// SDFCage — CLI: what one run did, as a text summary and as a JSON report.
+#pragma once
+
+#include <ostream>
+#include <string>
+
+namespace sdfcage_cli
+{
+
+/// Everything the program reports. Result fields are named like vtkSDFCageFilter's getters and
+/// the JSON keys are exactly these names.
+struct RunReport
+{
+  // what was asked
+  std::string InputFile;  ///< path, or "builtin" for the built-in shape
+  std::string OutputFile; ///< path written, "" when nothing was written
+  std::string ReportFile;
+  std::string ScreenshotFile; ///< "" when none was written
+  double IsoValue = 0.0;
+  double VoxelSize = 0.0;
+  double MinimumClearance = 0.0;
+  double MinimumClearanceUsed = 0.0; ///< after "0 = automatic"
+  int NumberOfThreads = 0;
+
+  // counts
+  long long InputPoints = 0;
+  long long InputCells = 0;
+  long long InputTriangles = 0;
+  long long EnvelopePoints = 0;
+  long long EnvelopeTriangles = 0;
+  long long CagePoints = 0;
+  long long CageTriangles = 0;
+
+  // the filter's results
+  double ReadTime = 0.0;
+  double ValidationTime = 0.0;
+  double DistanceFieldTime = 0.0;
+  double IsosurfaceTime = 0.0;
+  double VerificationTime = 0.0;
+  double TotalTime = 0.0;
+  double WriteTime = 0.0;
+  double MeasuredClearance = 0.0;
+  double MeasuredClearanceRelative = 0.0;
+  bool EnclosureVerified = false;
+  int RemovedPockets = 0;
+  int EnvelopeGenus = 0;
+  double VoxelSizeUsed = 0.0;
+  bool InputWasFlipped = false;
+  bool FilterRan = false; ///< false when the run stopped before the filter (e.g. unreadable)
+
+  // outcome
+  std::string Status = "NotRun"; ///< the filter's status string, or a CLI-level one
+  std::string ErrorMessage;
+  int ExitCode = 0;
+};
+
+/// The human-readable summary (several lines).
+void printSummary(std::ostream& os, const RunReport& r);
+
+/// Writes the JSON report. Returns false with a reason.
+bool writeJsonReport(const RunReport& r, const std::string& path, std::string& error);
+
+/// The report as a JSON object (also used by the tests through the file).
+std::string toJson(const RunReport& r);
+
+} // namespace sdfcage_cli

@@ -1,0 +1,272 @@
+// SDFCage — CLI: see CLIScreenshot.h.
+#include "CLIScreenshot.h"
+
+#if SDFCAGE_CLI_HAVE_RENDERING
+
+#include "CLIMessages.h"
+
+#include <vtkActor.h>
+#include <vtkCamera.h>
+#include <vtkColorTransferFunction.h>
+#include <vtkDataArray.h>
+#include <vtkNew.h>
+#include <vtkPNGWriter.h>
+#include <vtkPointData.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataMapper.h>
+#include <vtkPolyDataNormals.h>
+#include <vtkProperty.h>
+#include <vtkRenderWindow.h>
+#include <vtkRenderer.h>
+#include <vtkScalarBarActor.h>
+#include <vtkTextActor.h>
+#include <vtkTextProperty.h>
+#include <vtkWindowToImageFilter.h>
+
+#include <cstdlib>
+#include <filesystem>
+
+namespace sdfcage_cli
+{
+
+/// In CLIDisplay.cxx, the only file that includes Xlib.h (its macros clash with other headers).
+bool canOpenXDisplay();
+
+namespace
+{
+
+/// VTK's X render window aborts the process when it cannot connect to the display: check the
+/// connection ourselves first.
+bool displayReachable(std::string& error)
+{
+  const char* name = std::getenv("DISPLAY");
+  if (!name || !*name)
+  {
+    error = "cannot render: DISPLAY is not set (rendering needs an X server; on a headless "
+            "machine run the command under `xvfb-run -a`)";
+    return false;
+  }
+  if (!canOpenXDisplay())
+  {
+    error = std::string("cannot render: cannot open the X display '") + name +
+      "' (rendering needs an X server; on a headless machine run the command under "
+      "`xvfb-run -a`)";
+    return false;
+  }
+  return true;
+}
+
+vtkSmartPointer<vtkPolyData> withNormals(vtkPolyData* mesh)
+{
+  vtkNew<vtkPolyDataNormals> normals;
+  normals->SetInputData(mesh);
+  normals->SplittingOff();
+  normals->ConsistencyOff(); // both meshes are already consistently oriented
+  normals->Update();
+  return normals->GetOutput();
+}
+
+} // namespace
+
+bool renderingAvailable()
+{
+  return true;
+}
+
+bool canRender(std::string& error)
+{
+  return displayReachable(error);
+}
+
+bool writeScreenshot(vtkPolyData* input, vtkPolyData* cage, const std::string& title,
+  const std::string& path, std::string& error)
+{
+  if (!displayReachable(error))
+  {
+    return false;
+  }
+  MessageCollector* messages = MessageCollector::SafeDownCast(vtkOutputWindow::GetInstance());
+  if (messages)
+  {
+    messages->clear();
+  }
+
+  vtkNew<vtkRenderWindow> window;
+  window->SetOffScreenRendering(1);
+  window->SetSize(1200, 800);
+  window->SetMultiSamples(0);
+  window->SetAlphaBitPlanes(1); // depth peeling for the translucent cage
+  if (!window->SupportsOpenGL())
+  {
+    error = "cannot render: the X server offers no usable OpenGL (GLX) context";
+    return false;
+  }
+
+  vtkNew<vtkRenderer> renderer;
+  renderer->GradientBackgroundOn();
+  renderer->SetBackground(0.78, 0.82, 0.88); // bottom
+  renderer->SetBackground2(1.0, 1.0, 1.0);   // top
+  renderer->SetUseDepthPeeling(1);
+  renderer->SetMaximumNumberOfPeels(8);
+  renderer->SetOcclusionRatio(0.0);
+  window->AddRenderer(renderer);
+
+  // input: opaque, light grey
+  vtkNew<vtkPolyDataMapper> inputMapper;
+  inputMapper->SetInputData(withNormals(input));
+  inputMapper->ScalarVisibilityOff();
+  vtkNew<vtkActor> inputActor;
+  inputActor->SetMapper(inputMapper);
+  inputActor->GetProperty()->SetColor(0.83, 0.83, 0.83);
+  inputActor->GetProperty()->SetSpecular(0.2);
+  inputActor->GetProperty()->SetSpecularPower(20.0);
+  renderer->AddActor(inputActor);
+
+  // cage: translucent, coloured by DistanceToInput
+  if (cage && cage->GetNumberOfCells() > 0)
+  {
+    vtkSmartPointer<vtkPolyData> shaded = withNormals(cage);
+    vtkNew<vtkPolyDataMapper> cageMapper;
+    cageMapper->SetInputData(shaded);
+    vtkDataArray* distance = shaded->GetPointData()->GetArray("DistanceToInput");
+    // a sequential map (viridis' control colours): the distances of an envelope are nearly
+    // constant, a diverging map would show them all as its grey midpoint
+    vtkNew<vtkColorTransferFunction> colors;
+    colors->SetColorSpaceToLab();
+    double range[2] = { 0.0, 1.0 };
+    if (distance)
+    {
+      distance->GetRange(range, 0);
+      if (!(range[1] > range[0]))
+      {
+        range[1] = range[0] + 1e-12;
+      }
+    }
+    const double viridis[5][3] = { { 0.267, 0.005, 0.329 }, { 0.231, 0.322, 0.545 },
+      { 0.129, 0.569, 0.549 }, { 0.369, 0.788, 0.384 }, { 0.992, 0.906, 0.145 } };
+    for (int k = 0; k < 5; ++k)
+    {
+      colors->AddRGBPoint(range[0] + (range[1] - range[0]) * k / 4.0, viridis[k][0],
+        viridis[k][1], viridis[k][2]);
+    }
+    if (distance)
+    {
+      cageMapper->SetScalarModeToUsePointFieldData();
+      cageMapper->SelectColorArray("DistanceToInput");
+      cageMapper->SetLookupTable(colors);
+      cageMapper->SetScalarRange(range);
+      cageMapper->ScalarVisibilityOn();
+    }
+    else
+    {
+      cageMapper->ScalarVisibilityOff();
+    }
+    vtkNew<vtkActor> cageActor;
+    cageActor->SetMapper(cageMapper);
+    cageActor->GetProperty()->SetOpacity(0.4);
+    if (!distance)
+    {
+      cageActor->GetProperty()->SetColor(0.129, 0.569, 0.549);
+    }
+    if (cage->GetNumberOfCells() <= 20000)
+    {
+      // a coarse cage reads better with its edges; a dense envelope would turn black
+      cageActor->GetProperty()->EdgeVisibilityOn();
+      cageActor->GetProperty()->SetEdgeColor(0.25, 0.25, 0.3);
+    }
+    renderer->AddActor(cageActor);
+
+    if (distance)
+    {
+      vtkNew<vtkScalarBarActor> bar;
+      bar->SetLookupTable(colors);
+      bar->SetTitle("Distance to input");
+      bar->SetNumberOfLabels(5);
+      bar->SetLabelFormat("%.3g");
+      bar->SetPosition(0.87, 0.12);
+      bar->SetWidth(0.1);
+      bar->SetHeight(0.72);
+      bar->UnconstrainedFontSizeOn();
+      bar->SetVerticalTitleSeparation(12);
+      for (vtkTextProperty* text : { bar->GetTitleTextProperty(), bar->GetLabelTextProperty() })
+      {
+        text->SetColor(0.15, 0.15, 0.15);
+        text->ShadowOff();
+        text->ItalicOff();
+        text->SetFontSize(16);
+      }
+      renderer->AddActor2D(bar);
+    }
+  }
+
+  vtkNew<vtkTextActor> caption;
+  caption->SetInput(title.c_str());
+  caption->GetTextProperty()->SetFontSize(22);
+  caption->GetTextProperty()->SetColor(0.1, 0.1, 0.1);
+  caption->GetTextProperty()->SetJustificationToCentered();
+  caption->GetTextProperty()->SetVerticalJustificationToTop();
+  caption->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
+  caption->SetPosition(0.5, 0.96);
+  renderer->AddActor2D(caption);
+
+  renderer->ResetCamera();
+  vtkCamera* camera = renderer->GetActiveCamera();
+  camera->Elevation(25.0);
+  camera->Azimuth(30.0);
+  camera->OrthogonalizeViewUp();
+  renderer->ResetCamera();
+  camera->Zoom(1.25);
+
+  window->Render();
+
+  vtkNew<vtkWindowToImageFilter> grab;
+  grab->SetInput(window);
+  grab->SetInputBufferTypeToRGB();
+  grab->ReadFrontBufferOff();
+  grab->Update();
+
+  vtkNew<vtkPNGWriter> png;
+  png->SetFileName(path.c_str());
+  png->SetInputConnection(grab->GetOutputPort());
+  png->Write();
+
+  std::error_code ec;
+  if (png->GetErrorCode() != 0 || !std::filesystem::exists(path, ec) ||
+    (messages && !messages->errors().empty()))
+  {
+    error = "cannot write the screenshot '" + path + "'" +
+      ((messages && !messages->errors().empty()) ? ": " + messages->errors().front()
+                                                 : std::string());
+    return false;
+  }
+  return true;
+}
+
+} // namespace sdfcage_cli
+
+#else // no rendering in this build
+
+namespace sdfcage_cli
+{
+
+bool renderingAvailable()
+{
+  return false;
+}
+
+bool canRender(std::string& error)
+{
+  error = "cannot render: this sdfcage was built without VTK rendering (VTK::RenderingOpenGL2 "
+          "or one of its dependencies was not found when it was configured)";
+  return false;
+}
+
+bool writeScreenshot(vtkPolyData*, vtkPolyData*, const std::string&, const std::string&,
+  std::string& error)
+{
+  return canRender(error);
+}
+
+} // namespace sdfcage_cli
+
+#endif

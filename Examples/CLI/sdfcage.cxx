@@ -1,0 +1,673 @@
+// SDFCage — the command-line program: a closed mesh (or the built-in shape) -> its cage.
+//
+//   sdfcage [INPUT] [-o OUT] [--iso C] [--voxel H] [--clearance D] [--refinements N]
+//           [--report FILE.json] [--screenshot FILE.png] [--threads N] [--quiet]
+//           [--help] [--version]
+//
+// Exit codes: 0 cage written and enclosure verified; 1 enclosure could not be verified;
+// 2 bad command line or unusable input; 3 could not write an output, render, or other failure;
+// 130 interrupted (Ctrl-C).
+#include "CLIMeshIO.h"
+#include "CLIMessages.h"
+#include "CLIReport.h"
+#include "CLIScreenshot.h"
+
+#include "Envelope.h" // sdfcage::EnvelopeOptions: what "0 = automatic" resolves to
+
+#include <vtkSDFCageFilter.h>
+
+#include <vtkCommand.h>
+#include <vtkNew.h>
+#include <vtkPolyData.h>
+#include <vtkSmartPointer.h>
+#include <vtkVersion.h>
+
+#include <algorithm>
+#include <chrono>
+#include <csignal>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <filesystem>
+#include <iostream>
+#include <new>
+#include <string>
+#include <vector>
+
+#include <unistd.h> // isatty
+
+#ifndef SDFCAGE_VERSION
+#define SDFCAGE_VERSION "unknown"
+#endif
+
+namespace
+{
+
+using namespace sdfcage_cli;
+
+enum ExitCode
+{
+  ExitOk = 0,
+  ExitNotVerified = 1,
+  ExitUnusable = 2, // bad command line or unusable input
+  ExitFailure = 3,  // could not write, could not render, internal error
+  ExitInterrupted = 130
+};
+
+const char* const Program = "sdfcage";
+
+void printUsage(std::ostream& os)
+{
+  os << "Usage: sdfcage [INPUT] [options]\n"
+        "\n"
+        "Builds a cage (a coarse closed mesh that strictly encloses the input) from an SDF\n"
+        "envelope and verifies it. INPUT is a closed triangle/polygon mesh: "
+     << supportedExtensions()
+     << ".\n"
+        "Without INPUT the built-in shape (a torus beside a sphere) is used.\n"
+        "\n"
+        "Options (lengths are relative: the input is scaled into the unit sphere):\n"
+        "  -o, --output FILE       cage file; format from the extension ("
+     << supportedExtensions()
+     << ")\n"
+        "                          default: <input stem>_cage.vtp (builtin_cage.vtp) in the\n"
+        "                          current folder\n"
+        "      --iso C             isovalue of the envelope, default 0.01\n"
+        "      --voxel H           voxel size of the distance grid, default 0 = automatic (C/2)\n"
+        "      --clearance D       clearance every cage triangle keeps from the input,\n"
+        "                          default 0 = automatic (C/4)\n"
+        "      --refinements N     times the grid may be refined if verification fails, default 2\n"
+        "      --report FILE.json  write the results as JSON\n"
+        "      --screenshot FILE.png\n"
+        "                          render input and cage offscreen to a PNG (needs an X server:\n"
+        "                          on a headless machine run under `xvfb-run -a`)\n"
+        "      --threads N         worker threads, default 0 = all cores\n"
+        "  -q, --quiet             no progress bar, no summary (errors are still printed)\n"
+        "  -h, --help              this help\n"
+        "      --version           program and library versions\n"
+        "\n"
+        "Exit codes: 0 cage written and enclosure verified; 1 enclosure not verified;\n"
+        "2 bad command line or unusable input (missing file, unknown format, open or\n"
+        "non-manifold mesh, ...); 3 an output could not be written or rendered; 130 interrupted.\n";
+}
+
+struct Options
+{
+  std::string Input; ///< "" = built-in shape
+  std::string Output;
+  std::string Report;
+  std::string Screenshot;
+  double IsoValue = 0.01;
+  double VoxelSize = 0.0;
+  double Clearance = 0.0;
+  int Refinements = -1; ///< -1 = the filter's default
+  int Threads = 0;
+  bool Quiet = false;
+  bool Help = false;
+  bool Version = false;
+};
+
+/// Thrown for a bad command line; main() prints the message and the usage, exit code 2.
+struct UsageError
+{
+  std::string Message;
+};
+
+double parseDouble(const std::string& option, const std::string& text, double lo, double hi)
+{
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (text.empty() || !end || *end != '\0' || !(v >= lo && v <= hi))
+  {
+    char range[96];
+    std::snprintf(range, sizeof(range), "a number in [%g, %g]", lo, hi);
+    throw UsageError{ option + " expects " + range + ", got '" + text + "'" };
+  }
+  return v;
+}
+
+int parseInt(const std::string& option, const std::string& text, int lo, int hi)
+{
+  char* end = nullptr;
+  const long v = std::strtol(text.c_str(), &end, 10);
+  if (text.empty() || !end || *end != '\0' || v < lo || v > hi)
+  {
+    throw UsageError{ option + " expects an integer in [" + std::to_string(lo) + ", " +
+      std::to_string(hi) + "], got '" + text + "'" };
+  }
+  return static_cast<int>(v);
+}
+
+Options parseOptions(int argc, char* argv[], vtkSDFCageFilter* limits)
+{
+  Options o;
+  bool positionalOnly = false;
+  for (int i = 1; i < argc; ++i)
+  {
+    std::string arg = argv[i];
+    if (positionalOnly || arg.empty() || arg[0] != '-' || arg == "-")
+    {
+      if (!o.Input.empty())
+      {
+        throw UsageError{ "more than one input given ('" + o.Input + "' and '" + arg +
+          "'): sdfcage reads one mesh" };
+      }
+      if (arg.empty())
+      {
+        throw UsageError{ "empty input file name" };
+      }
+      o.Input = arg;
+      continue;
+    }
+    if (arg == "--")
+    {
+      positionalOnly = true;
+      continue;
+    }
+    // --name=value or --name value
+    std::string value;
+    bool hasInlineValue = false;
+    if (arg.compare(0, 2, "--") == 0)
+    {
+      const std::size_t eq = arg.find('=');
+      if (eq != std::string::npos)
+      {
+        value = arg.substr(eq + 1);
+        arg = arg.substr(0, eq);
+        hasInlineValue = true;
+      }
+    }
+    auto takeValue = [&]() -> std::string {
+      if (hasInlineValue)
+      {
+        return value;
+      }
+      if (i + 1 >= argc)
+      {
+        throw UsageError{ "option " + arg + " needs a value" };
+      }
+      return argv[++i];
+    };
+    auto noValue = [&]() {
+      if (hasInlineValue)
+      {
+        throw UsageError{ "option " + arg + " takes no value" };
+      }
+    };
+
+    if (arg == "-h" || arg == "--help")
+    {
+      noValue();
+      o.Help = true;
+    }
+    else if (arg == "--version")
+    {
+      noValue();
+      o.Version = true;
+    }
+    else if (arg == "-q" || arg == "--quiet")
+    {
+      noValue();
+      o.Quiet = true;
+    }
+    else if (arg == "-o" || arg == "--output")
+    {
+      o.Output = takeValue();
+      if (o.Output.empty())
+      {
+        throw UsageError{ "option " + arg + " needs a file name" };
+      }
+    }
+    else if (arg == "--report")
+    {
+      o.Report = takeValue();
+      if (o.Report.empty())
+      {
+        throw UsageError{ "option --report needs a file name" };
+      }
+    }
+    else if (arg == "--screenshot")
+    {
+      o.Screenshot = takeValue();
+      if (lowerExtension(o.Screenshot) != ".png")
+      {
+        throw UsageError{ "--screenshot writes PNG: the file name must end in .png, got '" +
+          o.Screenshot + "'" };
+      }
+    }
+    else if (arg == "--iso")
+    {
+      o.IsoValue = parseDouble(
+        arg, takeValue(), limits->GetIsoValueMinValue(), limits->GetIsoValueMaxValue());
+    }
+    else if (arg == "--voxel")
+    {
+      o.VoxelSize = parseDouble(
+        arg, takeValue(), limits->GetVoxelSizeMinValue(), limits->GetVoxelSizeMaxValue());
+    }
+    else if (arg == "--clearance")
+    {
+      o.Clearance = parseDouble(arg, takeValue(), limits->GetMinimumClearanceMinValue(),
+        limits->GetMinimumClearanceMaxValue());
+    }
+    else if (arg == "--refinements")
+    {
+      o.Refinements = parseInt(arg, takeValue(), limits->GetMaximumRefinementsMinValue(),
+        limits->GetMaximumRefinementsMaxValue());
+    }
+    else if (arg == "--threads")
+    {
+      o.Threads = parseInt(arg, takeValue(), limits->GetNumberOfThreadsMinValue(),
+        limits->GetNumberOfThreadsMaxValue());
+    }
+    else
+    {
+      throw UsageError{ "unknown option '" + arg + "'" };
+    }
+  }
+  if (!o.Input.empty() && !isSupportedExtension(o.Input))
+  {
+    throw UsageError{ "cannot read '" + o.Input + "': unknown extension '" +
+      lowerExtension(o.Input) + "' (supported: " + supportedExtensions() + ")" };
+  }
+  if (!o.Output.empty() && !isSupportedExtension(o.Output))
+  {
+    throw UsageError{ "cannot write '" + o.Output + "': unknown extension '" +
+      lowerExtension(o.Output) + "' (supported: " + supportedExtensions() + ")" };
+  }
+  if (o.Output.empty())
+  {
+    const std::string stem =
+      o.Input.empty() ? std::string("builtin") : std::filesystem::path(o.Input).stem().string();
+    o.Output = stem + "_cage.vtp";
+  }
+  return o;
+}
+
+// --- Ctrl-C: the first one cancels the filter cleanly, a second one kills --------------------
+volatile std::sig_atomic_t InterruptRequested = 0;
+
+extern "C" void onInterrupt(int)
+{
+  InterruptRequested = 1;
+  std::signal(SIGINT, SIG_DFL);
+}
+
+// --- progress bar on a terminal --------------------------------------------------------------
+class ProgressBar : public vtkCommand
+{
+public:
+  static ProgressBar* New() { return new ProgressBar; }
+
+  bool Enabled = false;
+
+  void Execute(vtkObject* caller, unsigned long, void* callData) override
+  {
+    vtkAlgorithm* algorithm = vtkAlgorithm::SafeDownCast(caller);
+    if (InterruptRequested && algorithm)
+    {
+      algorithm->SetAbortExecute(1);
+    }
+    if (!this->Enabled || !callData)
+    {
+      return;
+    }
+    const double fraction = *static_cast<double*>(callData);
+    const int percent = static_cast<int>(fraction * 100.0 + 0.5);
+    const char* text = algorithm ? algorithm->GetProgressText() : nullptr;
+    const std::string stage = (text && *text) ? text : "building the cage";
+    if (percent == this->LastPercent && stage == this->LastStage)
+    {
+      return;
+    }
+    this->LastPercent = percent;
+    this->LastStage = stage;
+    this->draw(fraction, percent, stage);
+  }
+
+  /// Shows a step that reports no progress of its own (reading, writing, rendering).
+  void step(const std::string& stage, double fraction)
+  {
+    if (this->Enabled)
+    {
+      this->LastStage = stage;
+      this->LastPercent = static_cast<int>(fraction * 100.0 + 0.5);
+      this->draw(fraction, this->LastPercent, stage);
+    }
+  }
+
+  /// Ends the bar's line (if anything was drawn).
+  void finish()
+  {
+    if (this->Drawn)
+    {
+      std::fputc('\n', stderr);
+      std::fflush(stderr);
+      this->Drawn = false;
+    }
+  }
+
+private:
+  void draw(double fraction, int percent, const std::string& stage)
+  {
+    constexpr int width = 30;
+    const int filled = std::max(0, std::min(width, static_cast<int>(fraction * width + 0.5)));
+    std::string bar(static_cast<std::size_t>(filled), '#');
+    bar.append(static_cast<std::size_t>(width - filled), '.');
+    std::string label = stage.substr(0, 40);
+    label.resize(40, ' '); // overwrite a longer previous stage name
+    std::fprintf(stderr, "\r[%s] %3d%%  %s", bar.c_str(), percent, label.c_str());
+    std::fflush(stderr);
+    this->Drawn = true;
+  }
+
+  int LastPercent = -1;
+  std::string LastStage;
+  bool Drawn = false;
+};
+
+void printError(const std::string& message)
+{
+  std::cerr << Program << ": error: " << message << "\n";
+}
+
+/// Prints collected VTK warnings (unless quiet) and clears them.
+void flushWarnings(MessageCollector* messages, bool quiet, ProgressBar* bar)
+{
+  if (!quiet && !messages->warnings().empty())
+  {
+    bar->finish(); // warnings go on lines of their own
+    for (const std::string& w : messages->warnings())
+    {
+      std::cerr << Program << ": warning: " << w << "\n";
+    }
+  }
+  messages->clear();
+}
+
+std::string shortNumber(double v)
+{
+  char buffer[32];
+  std::snprintf(buffer, sizeof(buffer), "%.3g", v);
+  return buffer;
+}
+
+/// Writes the report (if asked) and returns the exit code.
+int finish(const Options& o, RunReport& r, int code)
+{
+  r.ExitCode = code;
+  if (!o.Report.empty())
+  {
+    std::string error;
+    if (!writeJsonReport(r, o.Report, error))
+    {
+      printError(error);
+      return code == ExitOk ? ExitFailure : code;
+    }
+  }
+  return code;
+}
+
+int run(const Options& o, MessageCollector* messages)
+{
+  RunReport r;
+  r.InputFile = o.Input.empty() ? "builtin" : o.Input;
+  r.ReportFile = o.Report;
+  r.IsoValue = o.IsoValue;
+  r.VoxelSize = o.VoxelSize;
+  r.MinimumClearance = o.Clearance;
+  r.NumberOfThreads = o.Threads;
+  {
+    sdfcage::EnvelopeOptions resolved;
+    resolved.IsoValue = o.IsoValue;
+    resolved.MinimumClearance = o.Clearance;
+    r.MinimumClearanceUsed = resolved.clearance();
+  }
+
+  if (!o.Screenshot.empty())
+  {
+    // fail before the long computation, not after it
+    std::string error;
+    if (!canRender(error))
+    {
+      printError(error);
+      r.Status = "RenderingUnavailable";
+      r.ErrorMessage = error;
+      return finish(o, r, ExitFailure);
+    }
+  }
+
+  vtkNew<ProgressBar> progress;
+  progress->Enabled = !o.Quiet && isatty(STDERR_FILENO);
+
+  // --- read ---
+  using Clock = std::chrono::steady_clock;
+  auto since = [](Clock::time_point start) {
+    return std::chrono::duration<double>(Clock::now() - start).count();
+  };
+  Clock::time_point start = Clock::now();
+  vtkSmartPointer<vtkPolyData> input;
+  if (o.Input.empty())
+  {
+    input = builtinShape();
+  }
+  else
+  {
+    progress->step("reading " + std::filesystem::path(o.Input).filename().string(), 0.0);
+    std::string error;
+    input = readMesh(o.Input, error);
+    if (!input)
+    {
+      progress->finish();
+      printError(error);
+      r.Status = "UnreadableInput";
+      r.ErrorMessage = error;
+      return finish(o, r, ExitUnusable);
+    }
+  }
+  r.ReadTime = since(start);
+  r.InputPoints = input->GetNumberOfPoints();
+  r.InputCells = input->GetNumberOfPolys() + input->GetNumberOfStrips();
+  r.InputTriangles = triangleCount(input);
+  flushWarnings(messages, o.Quiet, progress);
+
+  // --- build the cage ---
+  vtkNew<vtkSDFCageFilter> filter;
+  filter->SetInputData(input);
+  filter->SetIsoValue(o.IsoValue);
+  filter->SetVoxelSize(o.VoxelSize);
+  filter->SetMinimumClearance(o.Clearance);
+  if (o.Refinements >= 0)
+  {
+    filter->SetMaximumRefinements(o.Refinements);
+  }
+  filter->SetNumberOfThreads(o.Threads);
+  filter->AddObserver(vtkCommand::ProgressEvent, progress);
+  std::signal(SIGINT, onInterrupt);
+  filter->Update();
+  std::signal(SIGINT, SIG_DFL);
+
+  vtkPolyData* cage = filter->GetOutput(0);
+  vtkPolyData* envelope = vtkPolyData::SafeDownCast(filter->GetOutputDataObject(1));
+  r.FilterRan = true;
+  r.Status = filter->GetStatusString();
+  r.ErrorMessage = filter->GetLastErrorMessage();
+  r.ValidationTime = filter->GetValidationTime();
+  r.DistanceFieldTime = filter->GetDistanceFieldTime();
+  r.IsosurfaceTime = filter->GetIsosurfaceTime();
+  r.VerificationTime = filter->GetVerificationTime();
+  r.TotalTime = filter->GetTotalTime();
+  r.MeasuredClearance = filter->GetMeasuredClearance();
+  r.MeasuredClearanceRelative = filter->GetMeasuredClearanceRelative();
+  r.EnclosureVerified = filter->GetEnclosureVerified();
+  r.RemovedPockets = filter->GetRemovedPockets();
+  r.EnvelopeGenus = filter->GetEnvelopeGenus();
+  r.VoxelSizeUsed = filter->GetVoxelSizeUsed();
+  r.InputWasFlipped = filter->GetInputWasFlipped();
+  r.CagePoints = cage ? cage->GetNumberOfPoints() : 0;
+  r.CageTriangles = cage ? triangleCount(cage) : 0;
+  r.EnvelopePoints = envelope ? envelope->GetNumberOfPoints() : 0;
+  r.EnvelopeTriangles = envelope ? triangleCount(envelope) : 0;
+  // The filter reports its errors through GetLastErrorMessage(): VTK's copy of them is not
+  // printed again, warnings are.
+  if (!o.Quiet && !messages->warnings().empty())
+  {
+    progress->finish(); // warnings go on lines of their own
+    for (const std::string& w : messages->warnings())
+    {
+      std::cerr << Program << ": warning: " << w << "\n";
+    }
+  }
+  const std::vector<std::string> filterErrors = messages->errors();
+  messages->clear();
+  if (r.Status != "Ok" || !r.EnclosureVerified)
+  {
+    progress->finish();
+  }
+
+  if (InterruptRequested || r.Status == "Cancelled")
+  {
+    printError("interrupted");
+    r.ErrorMessage = r.ErrorMessage.empty() ? "interrupted" : r.ErrorMessage;
+    return finish(o, r, ExitInterrupted);
+  }
+  if (r.Status == "InvalidInput" || r.Status == "EmptyInput")
+  {
+    const std::string why = !r.ErrorMessage.empty() ? r.ErrorMessage
+      : r.Status == "EmptyInput"                    ? std::string("the input has no triangles")
+                                                    : std::string("the input is not usable");
+    printError((o.Input.empty() ? std::string("the built-in shape") : "'" + o.Input + "'") +
+      ": " + why);
+    r.ErrorMessage = why;
+    return finish(o, r, ExitUnusable);
+  }
+  if (r.Status != "Ok" && r.Status != "VerificationFailed")
+  {
+    std::string why = r.ErrorMessage;
+    if (why.empty())
+    {
+      why = !filterErrors.empty() ? filterErrors.front()
+                                  : "the cage filter failed (status '" + r.Status + "')";
+    }
+    printError(why);
+    r.ErrorMessage = why;
+    return finish(o, r, ExitFailure);
+  }
+
+  int code = ExitOk;
+  const bool verified = r.Status == "Ok" && r.EnclosureVerified && r.CageTriangles > 0;
+  if (!verified)
+  {
+    code = ExitNotVerified;
+    std::string why = r.ErrorMessage.empty() ? "the enclosure could not be verified"
+                                             : r.ErrorMessage;
+    printError(why + " (no cage written)");
+    r.ErrorMessage = why;
+  }
+  else
+  {
+    // --- write ---
+    start = Clock::now();
+    progress->step("writing " + std::filesystem::path(o.Output).filename().string(), 1.0);
+    std::string error;
+    if (!writeMesh(cage, o.Output, error))
+    {
+      progress->finish();
+      printError(error);
+      r.Status = "WriteFailed";
+      r.ErrorMessage = error;
+      return finish(o, r, ExitFailure);
+    }
+    r.WriteTime = since(start);
+    r.OutputFile = o.Output;
+  }
+
+  // --- picture (also of an unverified envelope, to inspect it) ---
+  if (!o.Screenshot.empty())
+  {
+    vtkPolyData* shown = verified ? cage : envelope;
+    std::string title = std::string("SDFCage: ") +
+      (o.Input.empty() ? std::string("built-in shape")
+                       : std::filesystem::path(o.Input).filename().string()) +
+      (verified ? " and its cage (" : " and its UNVERIFIED envelope (") +
+      std::to_string(shown ? triangleCount(shown) : 0) + " triangles, clearance " +
+      shortNumber(r.MeasuredClearanceRelative) + " relative)";
+    progress->step("rendering " + std::filesystem::path(o.Screenshot).filename().string(), 1.0);
+    std::string error;
+    if (!writeScreenshot(input, shown, title, o.Screenshot, error))
+    {
+      progress->finish();
+      printError(error);
+      if (code == ExitOk)
+      {
+        r.Status = "ScreenshotFailed";
+        r.ErrorMessage = error;
+        code = ExitFailure;
+      }
+    }
+    else
+    {
+      r.ScreenshotFile = o.Screenshot;
+    }
+    flushWarnings(messages, o.Quiet, progress);
+  }
+
+  progress->finish();
+  if (!o.Quiet)
+  {
+    printSummary(std::cout, r);
+    std::cout.flush();
+  }
+  return finish(o, r, code);
+}
+
+} // namespace
+
+int main(int argc, char* argv[])
+{
+  try
+  {
+    MessageCollector* messages = MessageCollector::install();
+    Options options;
+    try
+    {
+      vtkNew<vtkSDFCageFilter> limits; // the parameter ranges come from the filter
+      options = parseOptions(argc, argv, limits);
+    }
+    catch (const UsageError& e)
+    {
+      printError(e.Message);
+      std::cerr << "\n";
+      printUsage(std::cerr);
+      return ExitUnusable;
+    }
+    if (options.Help)
+    {
+      printUsage(std::cout);
+      return ExitOk;
+    }
+    if (options.Version)
+    {
+      std::cout << "sdfcage " << SDFCAGE_VERSION << " (VTK " << vtkVersion::GetVTKVersion()
+                << (renderingAvailable() ? ", with rendering" : ", without rendering")
+                << ")\n";
+      return ExitOk;
+    }
+    return run(options, messages);
+  }
+  catch (const std::bad_alloc&)
+  {
+    printError("out of memory (try a larger --voxel)");
+    return ExitFailure;
+  }
+  catch (const std::exception& e)
+  {
+    printError(std::string("internal error: ") + e.what());
+    return ExitFailure;
+  }
+  catch (...)
+  {
+    printError("internal error (unknown exception)");
+    return ExitFailure;
+  }
+}
