@@ -1,6 +1,7 @@
 #include "CageGenerator.h"
 
 #include "Progress.h"
+#include "TriangleTree.h"
 
 #include <tbb/global_control.h>
 
@@ -61,7 +62,8 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
   const TriangleMesh unit = n.toUnit(mesh);
 
   // 3. the verified envelope
-  EnvelopeResult env = buildEnvelope(unit, options.Envelope, progress);
+  EnvelopeResult env =
+    buildEnvelope(unit, options.Envelope, progress, options.TargetNumberOfVertices > 0 ? 0.45 : 1.0);
   result.DistanceFieldSeconds = env.DistanceFieldSeconds;
   result.IsosurfaceSeconds = env.IsosurfaceSeconds;
   result.VerificationSeconds = env.VerificationSeconds;
@@ -96,9 +98,58 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
     }
   }
 
-  // 4. the cage: for now the verified envelope itself (a valid dense cage)
-  result.Cage = result.Envelope;
-  result.CageDistanceToInput = result.EnvelopeDistanceToInput;
+  // 4. the cage: constrained simplification of the verified envelope, verified again
+  if (options.TargetNumberOfVertices <= 0)
+  {
+    result.Cage = result.Envelope;
+    result.CageDistanceToInput = result.EnvelopeDistanceToInput;
+    result.VerticesReached = static_cast<int>(result.Cage.Points.size());
+    result.TargetReached = true;
+  }
+  else
+  {
+    const TriangleTree tree(unit);
+    SimplifyOptions so = options.Simplify;
+    so.TargetVertices = options.TargetNumberOfVertices;
+    so.Clearance = options.Envelope.clearance();
+    progressStage(progress, "simplifying", 0.45, 0.95);
+    result.Simplification = simplifyEnvelope(env.Envelope, tree, so, progress);
+    result.SimplificationSeconds = result.Simplification.Seconds;
+    result.VerticesReached = result.Simplification.VerticesReached;
+    result.TargetReached = result.Simplification.ReachedTarget;
+    result.StopReason = result.Simplification.StopReason;
+    // independent re-verification of the final cage (exact distances, winding numbers). It runs
+    // even after a cancel: the partial cage is valid and usable.
+    progressStage(progress, "verifying cage", 0.95, 1.0);
+    const auto t1 = std::chrono::steady_clock::now();
+    std::vector<double> dist;
+    std::string why;
+    double clearance = 0.0;
+    const bool ok = verifyEnclosure(unit, result.Simplification.Cage, so.Clearance, clearance, why, &dist, nullptr);
+    result.CageVerificationSeconds = seconds(t1);
+    if (!ok)
+    {
+      result.State = Status::VerificationFailed;
+      result.Message = "the simplified cage failed verification: " + why;
+      result.EnclosureVerified = false;
+      result.TotalSeconds = seconds(start);
+      return result;
+    }
+    result.Cage = n.toInput(result.Simplification.Cage);
+    result.CageDistanceToInput.resize(dist.size());
+    for (std::size_t i = 0; i < dist.size(); ++i)
+      result.CageDistanceToInput[i] = n.lengthToInput(dist[i]);
+    result.MinimumClearanceRelative = clearance;
+    result.MinimumClearance = n.lengthToInput(clearance);
+    result.Simplification.Cage = TriangleMesh(); // the result keeps the input-unit copy only
+    if (result.Simplification.Cancelled)
+    {
+      result.State = Status::Cancelled;
+      result.Message = "cancelled during simplification; the cage so far is valid";
+      result.TotalSeconds = seconds(start);
+      return result;
+    }
+  }
   result.State = Status::Ok;
   result.TotalSeconds = seconds(start);
   progressUpdate(progress, 1.0);

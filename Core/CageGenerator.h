@@ -3,6 +3,7 @@
 
 #include "Envelope.h"
 #include "Normalization.h"
+#include "Simplification.h"
 #include "Validation.h"
 
 namespace sdfcage
@@ -12,6 +13,10 @@ struct CageOptions
 {
   EnvelopeOptions Envelope;
   ValidationOptions Validation;
+  /// Target vertex count of the cage; 0 keeps the dense verified envelope as the cage.
+  int TargetNumberOfVertices = 500;
+  /// Simplification knobs (Clearance is taken from Envelope.clearance()).
+  SimplifyOptions Simplify;
 };
 
 struct CageResult
@@ -19,7 +24,7 @@ struct CageResult
   Status State = Status::Failed;
   std::string Message;              ///< error or cancellation reason (empty when Ok)
   MeshDefects Defects;              ///< validation report of the input
-  TriangleMesh Cage;                ///< input coordinates (for now: the verified envelope)
+  TriangleMesh Cage;                ///< input coordinates
   std::vector<double> CageDistanceToInput; ///< per cage point, input units
   TriangleMesh Envelope;            ///< input coordinates
   std::vector<double> EnvelopeDistanceToInput; ///< per envelope point, input units
@@ -34,6 +39,12 @@ struct CageResult
   double DistanceFieldSeconds = 0.0;
   double IsosurfaceSeconds = 0.0;
   double VerificationSeconds = 0.0;
+  int VerticesReached = 0;          ///< cage vertex count
+  bool TargetReached = false;       ///< VerticesReached == TargetNumberOfVertices (or target 0)
+  std::string StopReason;           ///< why simplification stopped early (empty otherwise)
+  SimplifyResult Simplification;    ///< statistics of the simplification
+  double SimplificationSeconds = 0.0;
+  double CageVerificationSeconds = 0.0;
   double TotalSeconds = 0.0;
   ScalarImage DistanceField;        ///< input coordinates and units, when requested
   Normalization Normalize;

@@ -3,7 +3,7 @@
 #include "DistanceField.h"
 #include "Geometry.h"
 #include "Progress.h"
-#include "TriangleIndex.h"
+#include "TriangleTree.h"
 #include "Validation.h"
 
 #include <tbb/blocked_range.h>
@@ -138,8 +138,7 @@ bool verifyEnclosure(const TriangleMesh& input, const TriangleMesh& cage, double
     why = "the surface is not a closed 2-manifold: " + d.errorMessage();
     return false;
   }
-  TriangleIndex index;
-  index.build(input);
+  const TriangleTree index(input);
 
   // 1. exact distance of every cage point to the input
   const std::size_t nv = cage.Points.size();
@@ -267,7 +266,8 @@ bool verifyEnclosure(const TriangleMesh& input, const TriangleMesh& cage, double
   return true;
 }
 
-EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOptions& options, Progress* progress)
+EnvelopeResult buildEnvelope(
+  const TriangleMesh& unitInput, const EnvelopeOptions& options, Progress* progress, double progressEnd)
 {
   EnvelopeResult result;
   if (unitInput.empty())
@@ -287,7 +287,7 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
   }
   for (int attempt = 0; attempt <= std::max(0, options.MaximumRefinements); ++attempt, h *= 0.5)
   {
-    progressStage(progress, "distance field and isosurface", 0.02, 0.7);
+    progressStage(progress, "distance field and isosurface", 0.02, 0.7 * progressEnd);
     IsosurfaceOutput iso = computeIsosurface(unitInput, h, c, options.KeepDistanceField, progress, options.Adaptivity);
     result.DistanceFieldSeconds += iso.DistanceFieldSeconds;
     result.IsosurfaceSeconds += iso.IsosurfaceSeconds;
@@ -310,7 +310,7 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
     result.Refinements = attempt;
     result.DistanceField = std::move(iso.Field);
 
-    progressStage(progress, "verifying enclosure", 0.7, 1.0);
+    progressStage(progress, "verifying enclosure", 0.7 * progressEnd, progressEnd);
     auto t1 = std::chrono::steady_clock::now();
     std::string why;
     const bool ok = verifyEnclosure(unitInput, result.Envelope, delta, result.MinimumClearance, why,

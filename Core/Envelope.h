@@ -80,8 +80,9 @@ struct EnvelopeResult
 };
 
 /// Builds and verifies the envelope of a validated, normalized mesh (unit-sphere units).
+/// Progress runs from 0.02 to `progressEnd` of the whole run.
 EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOptions& options,
-  Progress* progress = nullptr);
+  Progress* progress = nullptr, double progressEnd = 1.0);
 
 /// Independent check used by buildEnvelope and by tests: closed 2-manifold, every triangle of
 /// `cage` at least `clearance` from `input` (exact distances), and one point of every input

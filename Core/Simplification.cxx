@@ -1,0 +1,700 @@
+#include "Simplification.h"
+
+#include "Geometry.h"
+#include "Progress.h"
+#include "TriangleTree.h"
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <queue>
+#include <unordered_map>
+#include <unordered_set>
+
+namespace sdfcage
+{
+
+namespace
+{
+
+// ---- Garland-Heckbert quadric: symmetric 4x4 stored as 10 coefficients ------------------------
+struct Quadric
+{
+  double A[10] = { 0, 0, 0, 0, 0, 0, 0, 0, 0, 0 }; // xx xy xz xw yy yz yw zz zw ww
+
+  static Quadric plane(const Vec3& n, double d, double w)
+  {
+    Quadric q;
+    const double a = n.x(), b = n.y(), c = n.z();
+    q.A[0] = w * a * a;
+    q.A[1] = w * a * b;
+    q.A[2] = w * a * c;
+    q.A[3] = w * a * d;
+    q.A[4] = w * b * b;
+    q.A[5] = w * b * c;
+    q.A[6] = w * b * d;
+    q.A[7] = w * c * c;
+    q.A[8] = w * c * d;
+    q.A[9] = w * d * d;
+    return q;
+  }
+  Quadric& operator+=(const Quadric& o)
+  {
+    for (int i = 0; i < 10; ++i)
+    {
+      A[i] += o.A[i];
+    }
+    return *this;
+  }
+  double eval(const Vec3& v) const
+  {
+    const double x = v.x(), y = v.y(), z = v.z();
+    return A[0] * x * x + 2 * A[1] * x * y + 2 * A[2] * x * z + 2 * A[3] * x + A[4] * y * y +
+      2 * A[5] * y * z + 2 * A[6] * y + A[7] * z * z + 2 * A[8] * z + A[9];
+  }
+  bool optimum(Vec3& v) const
+  {
+    Eigen::Matrix3d m;
+    m << A[0], A[1], A[2], A[1], A[4], A[5], A[2], A[5], A[7];
+    const Eigen::Vector3d b(-A[3], -A[6], -A[8]);
+    // accept only well-conditioned systems (flat or cylindrical regions have no unique optimum)
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(m);
+    const Eigen::Vector3d ev = es.eigenvalues();
+    if (!(ev(2) > 0) || ev(0) < 1e-6 * ev(2))
+    {
+      return false;
+    }
+    v = es.eigenvectors() * ((es.eigenvectors().transpose() * b).cwiseQuotient(ev));
+    return v.allFinite();
+  }
+};
+
+// ---- dynamic uniform hash grid over the cage's triangle boxes ---------------------------------
+class CageGrid
+{
+public:
+  void reset(double cellSize)
+  {
+    Cell = cellSize;
+    Cells.clear();
+  }
+  double cellSize() const { return Cell; }
+  template <typename F>
+  void forCells(const Vec3& lo, const Vec3& hi, F&& f)
+  {
+    const std::int64_t i0 = key1(lo.x()), i1 = key1(hi.x());
+    const std::int64_t j0 = key1(lo.y()), j1 = key1(hi.y());
+    const std::int64_t k0 = key1(lo.z()), k1 = key1(hi.z());
+    for (std::int64_t k = k0; k <= k1; ++k)
+      for (std::int64_t j = j0; j <= j1; ++j)
+        for (std::int64_t i = i0; i <= i1; ++i)
+          f(((k & 0x1FFFFF) << 42) | ((j & 0x1FFFFF) << 21) | (i & 0x1FFFFF));
+  }
+  void insert(int t, const Vec3& lo, const Vec3& hi)
+  {
+    forCells(lo, hi, [&](std::int64_t key) { Cells[key].push_back(t); });
+  }
+  void remove(int t, const Vec3& lo, const Vec3& hi)
+  {
+    forCells(lo, hi, [&](std::int64_t key) {
+      auto it = Cells.find(key);
+      if (it == Cells.end())
+        return;
+      auto& v = it->second;
+      auto pos = std::find(v.begin(), v.end(), t);
+      if (pos != v.end())
+      {
+        *pos = v.back();
+        v.pop_back();
+      }
+    });
+  }
+  template <typename F>
+  void query(const Vec3& lo, const Vec3& hi, F&& f)
+  {
+    forCells(lo, hi, [&](std::int64_t key) {
+      auto it = Cells.find(key);
+      if (it != Cells.end())
+        for (int t : it->second)
+          f(t);
+    });
+  }
+
+private:
+  std::int64_t key1(double x) const { return static_cast<std::int64_t>(std::floor(x / Cell)); }
+  double Cell = 1.0;
+  std::unordered_map<std::int64_t, std::vector<int>> Cells;
+};
+
+struct Entry
+{
+  double Cost;
+  int V0, V1;
+  unsigned Ver0, Ver1;
+  Vec3 Pos;
+  bool operator<(const Entry& o) const
+  {
+    // min-heap on cost; ties broken by vertex ids so the order is deterministic
+    if (Cost != o.Cost)
+      return Cost > o.Cost;
+    if (V0 != o.V0)
+      return V0 > o.V0;
+    return V1 > o.V1;
+  }
+};
+
+enum class Verdict
+{
+  Ok,
+  Topology,
+  Shape,
+  Input,
+  Self
+};
+
+std::uint64_t edgeKey(int a, int b)
+{
+  if (a > b)
+    std::swap(a, b);
+  return (static_cast<std::uint64_t>(a) << 32) | static_cast<std::uint32_t>(b);
+}
+
+double triangleQuality(const Vec3& a, const Vec3& b, const Vec3& c)
+{
+  const double area2 = (b - a).cross(c - a).norm(); // twice the area
+  const double s = (b - a).squaredNorm() + (c - b).squaredNorm() + (a - c).squaredNorm();
+  return s > 0 ? 2.0 * std::sqrt(3.0) * area2 / s : 0.0;
+}
+
+// Is direction u inside the (closed) corner angle spanned by e1, e2 (normal n = e1 x e2)?
+bool inCorner(const Vec3& u, const Vec3& e1, const Vec3& e2, const Vec3& n)
+{
+  return e1.cross(u).dot(n) >= 0 && u.cross(e2).dot(n) >= 0;
+}
+
+// Two triangles sharing exactly the vertex a: do they meet anywhere else? (conservative: nearly
+// coplanar pairs count as meeting)
+bool meetBeyondSharedVertex(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& e)
+{
+  const Vec3 n1 = (b - a).cross(c - a), n2 = (d - a).cross(e - a);
+  const Vec3 u = n1.cross(n2);
+  const double scale = n1.norm() * n2.norm();
+  if (!(scale > 0))
+    return true;
+  if (u.norm() <= 1e-9 * scale)
+  {
+    // coplanar: they overlap beyond a if the corner angles overlap
+    const Vec3 n = n1.normalized();
+    return inCorner(d - a, b - a, c - a, n) || inCorner(e - a, b - a, c - a, n) ||
+      inCorner(b - a, d - a, e - a, n) || inCorner(c - a, d - a, e - a, n);
+  }
+  // the planes meet in the line a + s u; both triangles contain a piece of it on the same side
+  return (inCorner(u, b - a, c - a, n1) && inCorner(u, d - a, e - a, n2)) ||
+    (inCorner(-u, b - a, c - a, n1) && inCorner(-u, d - a, e - a, n2));
+}
+
+class Simplifier
+{
+public:
+  Simplifier(const TriangleMesh& mesh, const TriangleTree& input, const SimplifyOptions& o, Progress* p)
+    : Input(input)
+    , Opt(o)
+    , Prog(p)
+  {
+    P = mesh.Points;
+    T = mesh.Triangles;
+    VAlive.assign(P.size(), 1);
+    TAlive.assign(T.size(), 1);
+    VT.assign(P.size(), {});
+    for (std::size_t f = 0; f < T.size(); ++f)
+      for (int v : T[f])
+        VT[v].push_back(static_cast<int>(f));
+    Ver.assign(P.size(), 0);
+    Mark.assign(T.size(), 0);
+    AliveVertices = static_cast<int>(P.size());
+    AliveTriangles = static_cast<int>(T.size());
+    Q.assign(P.size(), Quadric());
+    for (const Triangle& t : T)
+    {
+      const Vec3 n = (P[t[1]] - P[t[0]]).cross(P[t[2]] - P[t[0]]);
+      const double area = 0.5 * n.norm();
+      if (!(area > 0))
+        continue;
+      const Vec3 u = n.normalized();
+      const Quadric q = Quadric::plane(u, -u.dot(P[t[0]]), area);
+      for (int v : t)
+        Q[v] += q;
+    }
+    rebuildGrid();
+  }
+
+  SimplifyResult run()
+  {
+    SimplifyResult r;
+    const auto t0 = std::chrono::steady_clock::now();
+    const int start = AliveVertices;
+    const int target = std::max(4, Opt.TargetVertices);
+    for (std::size_t v = 0; v < P.size(); ++v)
+      for (int n : neighbours(static_cast<int>(v)))
+        if (static_cast<int>(v) < n)
+          pushEdge(static_cast<int>(v), n);
+    long long sinceProgress = 0;
+    while (AliveVertices > target && !Heap.empty())
+    {
+      Entry e = Heap.top();
+      Heap.pop();
+      if (!VAlive[e.V0] || !VAlive[e.V1] || Ver[e.V0] != e.Ver0 || Ver[e.V1] != e.Ver1)
+        continue;
+      if (++sinceProgress >= 512)
+      {
+        sinceProgress = 0;
+        if (Prog && Prog->update(double(start - AliveVertices) / std::max(1, start - target)))
+        {
+          r.Cancelled = true;
+          break;
+        }
+      }
+      if (!gather(e.V0, e.V1))
+      {
+        ++Stats.RejectedTopology;
+        block(e.V0, e.V1);
+        continue;
+      }
+      Vec3 pos = e.Pos;
+      Verdict v = check(pos);
+      if (v == Verdict::Input || v == Verdict::Self || v == Verdict::Shape)
+      {
+        countReject(v);
+        if (v == Verdict::Input && relocate(pos))
+        {
+          ++Stats.Relocated;
+          const double cost = costAt(e.V0, e.V1, pos);
+          if (!Heap.empty() && cost > Heap.top().Cost)
+          {
+            // no longer the cheapest: queue it with its feasible placement
+            Heap.push({ cost, e.V0, e.V1, Ver[e.V0], Ver[e.V1], pos });
+            continue;
+          }
+          v = Verdict::Ok;
+        }
+        else
+        {
+          block(e.V0, e.V1);
+          continue;
+        }
+      }
+      collapse(pos);
+      ++Stats.Collapses;
+      if (AliveTriangles * 2 < GridTriangles)
+        rebuildGrid();
+    }
+    r = Stats;
+    r.Cancelled = r.Cancelled || progressCancelled(Prog);
+    r.VerticesReached = AliveVertices;
+    r.ReachedTarget = AliveVertices <= target;
+    if (!r.ReachedTarget)
+      r.StopReason = r.Cancelled ? "cancelled"
+                                 : "no remaining collapse keeps the clearance, self-intersection, "
+                                   "topology and shape constraints";
+    r.Cage = compact();
+    r.Seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return r;
+  }
+
+private:
+  // ---- adjacency ----
+  std::vector<int> neighbours(int v) const
+  {
+    std::vector<int> n;
+    for (int f : VT[v])
+      for (int w : T[f])
+        if (w != v)
+          n.push_back(w);
+    std::sort(n.begin(), n.end());
+    n.erase(std::unique(n.begin(), n.end()), n.end());
+    return n;
+  }
+
+  double costAt(int a, int b, const Vec3& p) const
+  {
+    Quadric q = Q[a];
+    q += Q[b];
+    return std::max(0.0, q.eval(p));
+  }
+
+  void pushEdge(int a, int b)
+  {
+    Quadric q = Q[a];
+    q += Q[b];
+    const Vec3 mid = 0.5 * (P[a] + P[b]);
+    Vec3 best = mid;
+    double bestCost = q.eval(mid);
+    Vec3 opt;
+    if (q.optimum(opt) && (opt - mid).norm() <= 2.0 * (P[a] - P[b]).norm())
+    {
+      best = opt;
+      bestCost = q.eval(opt);
+    }
+    else
+    {
+      for (const Vec3& c : { P[a], P[b] })
+      {
+        const double cc = q.eval(c);
+        if (cc < bestCost)
+        {
+          bestCost = cc;
+          best = c;
+        }
+      }
+    }
+    Heap.push({ std::max(0.0, bestCost), a, b, Ver[a], Ver[b], best });
+  }
+
+  void block(int a, int b) { Blocked.insert(edgeKey(a, b)); }
+
+  // ---- the collapse being evaluated (v0 survives, v1 goes) ----
+  int C0 = -1, C1 = -1;
+  std::vector<int> Removed, Changed;
+  unsigned MarkId = 0;
+
+  bool gather(int v0, int v1)
+  {
+    C0 = v0;
+    C1 = v1;
+    Removed.clear();
+    Changed.clear();
+    for (int f : VT[v0])
+    {
+      const Triangle& t = T[f];
+      if (t[0] == v1 || t[1] == v1 || t[2] == v1)
+        Removed.push_back(f);
+      else
+        Changed.push_back(f);
+    }
+    for (int f : VT[v1])
+    {
+      const Triangle& t = T[f];
+      if (!(t[0] == v0 || t[1] == v0 || t[2] == v0))
+        Changed.push_back(f);
+    }
+    if (Removed.size() != 2)
+      return false;
+    // link condition: the common neighbours of v0 and v1 are exactly the two opposite vertices
+    const std::vector<int> n0 = neighbours(v0), n1 = neighbours(v1);
+    std::vector<int> common;
+    std::set_intersection(n0.begin(), n0.end(), n1.begin(), n1.end(), std::back_inserter(common));
+    if (common.size() != 2)
+      return false;
+    // keep at least a tetrahedron per component
+    if (n0.size() + n1.size() <= 6 && AliveVertices <= 4)
+      return false;
+    ++MarkId;
+    if (MarkId == 0)
+    {
+      std::fill(Mark.begin(), Mark.end(), 0);
+      MarkId = 1;
+    }
+    for (int f : Removed)
+      Mark[f] = MarkId;
+    for (int f : Changed)
+      Mark[f] = MarkId;
+    return true;
+  }
+
+  // new vertex ids and positions of changed triangle f when the collapse puts v0 at p
+  void newTriangle(int f, const Vec3& p, int ids[3], Vec3 pts[3]) const
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      int v = T[f][k];
+      if (v == C1)
+        v = C0;
+      ids[k] = v;
+      pts[k] = v == C0 ? p : P[v];
+    }
+  }
+
+  Verdict check(const Vec3& p)
+  {
+    const double delta = Opt.Clearance;
+    const double selfDelta = Opt.selfClearance();
+    NewTris.resize(Changed.size());
+    // shape first (cheap): no needles, no flips
+    for (std::size_t i = 0; i < Changed.size(); ++i)
+    {
+      auto& nt = NewTris[i];
+      newTriangle(Changed[i], p, nt.Ids, nt.Pts);
+      if (triangleQuality(nt.Pts[0], nt.Pts[1], nt.Pts[2]) < Opt.MinimumTriangleQuality)
+        return Verdict::Shape;
+      const Triangle& old = T[Changed[i]];
+      const Vec3 no = (P[old[1]] - P[old[0]]).cross(P[old[2]] - P[old[0]]);
+      nt.N = (nt.Pts[1] - nt.Pts[0]).cross(nt.Pts[2] - nt.Pts[0]);
+      if (no.dot(nt.N) <= Opt.MinimumNormalCosine * no.norm() * nt.N.norm())
+        return Verdict::Shape;
+    }
+    // among the new triangles (they all share v0): no folds, no crossings
+    for (std::size_t i = 0; i < NewTris.size(); ++i)
+      for (std::size_t j = i + 1; j < NewTris.size(); ++j)
+        if (pairConflict(NewTris[i].Ids, NewTris[i].Pts, NewTris[j].Ids, NewTris[j].Pts, selfDelta))
+          return Verdict::Self;
+    // the input: clearance delta, exact triangle-triangle distances through the tree
+    for (const auto& nt : NewTris)
+      if (Input.anyCloserThan(nt.Pts, delta))
+        return Verdict::Input;
+    // the rest of the cage
+    for (const auto& nt : NewTris)
+    {
+      const Vec3 lo = nt.Pts[0].cwiseMin(nt.Pts[1]).cwiseMin(nt.Pts[2]) - Vec3::Constant(selfDelta);
+      const Vec3 hi = nt.Pts[0].cwiseMax(nt.Pts[1]).cwiseMax(nt.Pts[2]) + Vec3::Constant(selfDelta);
+      bool conflict = false;
+      ++QueryId;
+      Grid.query(lo, hi, [&](int f) {
+        if (conflict || !TAlive[f] || Mark[f] == MarkId || Seen[f] == QueryId)
+          return;
+        Seen[f] = QueryId;
+        const Vec3 op[3] = { P[T[f][0]], P[T[f][1]], P[T[f][2]] };
+        const Vec3 olo = op[0].cwiseMin(op[1]).cwiseMin(op[2]), ohi = op[0].cwiseMax(op[1]).cwiseMax(op[2]);
+        if ((olo.array() > hi.array()).any() || (ohi.array() < lo.array()).any())
+          return;
+        const int oid[3] = { T[f][0], T[f][1], T[f][2] };
+        conflict = pairConflict(nt.Ids, nt.Pts, oid, op, selfDelta);
+      });
+      if (conflict)
+        return Verdict::Self;
+    }
+    return Verdict::Ok;
+  }
+
+  // Do two cage triangles conflict? Disjoint ones must keep selfDelta apart; ones sharing a vertex
+  // must not meet elsewhere; ones sharing an edge must not fold onto each other.
+  static bool pairConflict(const int ia[3], const Vec3 pa[3], const int ib[3], const Vec3 pb[3], double selfDelta)
+  {
+    int sa[3], sb[3], shared = 0;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        if (ia[i] == ib[j])
+        {
+          sa[shared] = i;
+          sb[shared] = j;
+          ++shared;
+        }
+    if (shared == 0)
+      return triangleTriangleDistance2(pa, pb) < selfDelta * selfDelta;
+    if (shared == 1)
+    {
+      const int i = sa[0], j = sb[0];
+      return meetBeyondSharedVertex(pa[i], pa[(i + 1) % 3], pa[(i + 2) % 3], pb[(j + 1) % 3], pb[(j + 2) % 3]);
+    }
+    if (shared == 2)
+    {
+      const Vec3 na = (pa[1] - pa[0]).cross(pa[2] - pa[0]), nb = (pb[1] - pb[0]).cross(pb[2] - pb[0]);
+      // dihedral fold: the two faces turned almost onto each other
+      return na.dot(nb) < -0.95 * na.norm() * nb.norm();
+    }
+    return true; // the same triangle twice: a non-manifold configuration
+  }
+
+  // Gradient descent on Psi (eq. 5-6): move the placement so that the new one-ring moves away from
+  // the input where it is closer than the target (2 delta), sampling each new triangle at its
+  // corners, edge midpoints and centroid.
+  bool relocate(Vec3& p)
+  {
+    const double target = 2.0 * Opt.Clearance;
+    static const double bary[7][3] = { { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 }, { .5, .5, 0 },
+      { 0, .5, .5 }, { .5, 0, .5 }, { 1. / 3, 1. / 3, 1. / 3 } };
+    for (int it = 0; it < Opt.PlacementIterations; ++it)
+    {
+      Vec3 g = Vec3::Zero();
+      double worst = target;
+      for (int f : Changed)
+      {
+        int ids[3];
+        Vec3 pts[3];
+        newTriangle(f, p, ids, pts);
+        const double area = 0.5 * (pts[1] - pts[0]).cross(pts[2] - pts[0]).norm();
+        for (const auto& b : bary)
+        {
+          double lp = 0;
+          for (int k = 0; k < 3; ++k)
+            if (ids[k] == C0)
+              lp = b[k];
+          if (lp == 0)
+            continue;
+          const Vec3 x = b[0] * pts[0] + b[1] * pts[1] + b[2] * pts[2];
+          Vec3 c;
+          int tri;
+          double d;
+          if (!Input.closestPoint(x, target, c, tri, d))
+            continue; // comfortably clear
+          Vec3 dir = d > 0 ? Vec3((x - c) / d) : Input.normal(tri);
+          double xi = d;
+          if (dir.dot(Input.normal(tri)) < 0) // inside the input: the gradient points outward
+          {
+            dir = -dir;
+            xi = -d;
+          }
+          worst = std::min(worst, xi);
+          g += area * lp * (target - xi) * dir;
+        }
+      }
+      const double gn = g.norm();
+      if (!(gn > 0))
+        return false;
+      p += (g / gn) * (target - worst);
+      if (check(p) == Verdict::Ok)
+        return true;
+    }
+    return false;
+  }
+
+  void countReject(Verdict v)
+  {
+    if (v == Verdict::Input)
+      ++Stats.RejectedInput;
+    else if (v == Verdict::Self)
+      ++Stats.RejectedSelf;
+    else if (v == Verdict::Shape)
+      ++Stats.RejectedShape;
+  }
+
+  void box(int f, Vec3& lo, Vec3& hi) const
+  {
+    lo = P[T[f][0]].cwiseMin(P[T[f][1]]).cwiseMin(P[T[f][2]]);
+    hi = P[T[f][0]].cwiseMax(P[T[f][1]]).cwiseMax(P[T[f][2]]);
+  }
+
+  void collapse(const Vec3& p)
+  {
+    Vec3 lo, hi;
+    for (int f : Removed)
+    {
+      box(f, lo, hi);
+      Grid.remove(f, lo, hi);
+      TAlive[f] = 0;
+      --AliveTriangles;
+      for (int v : T[f])
+      {
+        auto& l = VT[v];
+        l.erase(std::remove(l.begin(), l.end(), f), l.end());
+      }
+    }
+    for (int f : Changed)
+    {
+      box(f, lo, hi);
+      Grid.remove(f, lo, hi);
+    }
+    for (int f : VT[C1])
+    {
+      for (int& v : T[f])
+        if (v == C1)
+          v = C0;
+      VT[C0].push_back(f);
+    }
+    VT[C1].clear();
+    P[C0] = p;
+    Q[C0] += Q[C1];
+    VAlive[C1] = 0;
+    --AliveVertices;
+    ++Ver[C0];
+    ++Ver[C1];
+    for (int f : Changed)
+    {
+      box(f, lo, hi);
+      Grid.insert(f, lo, hi);
+    }
+    const std::vector<int> ring = neighbours(C0);
+    for (int n : ring)
+    {
+      Blocked.erase(edgeKey(C0, n));
+      pushEdge(std::min(C0, n), std::max(C0, n));
+    }
+    // edges around the ring saw their neighbourhood change: retry the blocked ones
+    for (int r : ring)
+      for (int n : neighbours(r))
+        if (n != C0 && Blocked.erase(edgeKey(r, n)))
+          pushEdge(std::min(r, n), std::max(r, n));
+  }
+
+  void rebuildGrid()
+  {
+    double area = 0;
+    for (std::size_t f = 0; f < T.size(); ++f)
+      if (TAlive[f])
+        area += 0.5 * (P[T[f][1]] - P[T[f][0]]).cross(P[T[f][2]] - P[T[f][0]]).norm();
+    const double meanEdge = std::sqrt(4.0 * area / std::max(1, AliveTriangles) / std::sqrt(3.0));
+    Grid.reset(std::max(2.0 * meanEdge, 1e-6));
+    Vec3 lo, hi;
+    for (std::size_t f = 0; f < T.size(); ++f)
+      if (TAlive[f])
+      {
+        box(static_cast<int>(f), lo, hi);
+        Grid.insert(static_cast<int>(f), lo, hi);
+      }
+    GridTriangles = AliveTriangles;
+    Seen.assign(T.size(), 0);
+    QueryId = 0;
+  }
+
+  TriangleMesh compact() const
+  {
+    TriangleMesh m;
+    std::vector<int> map(P.size(), -1);
+    for (std::size_t v = 0; v < P.size(); ++v)
+      if (VAlive[v] && !VT[v].empty())
+      {
+        map[v] = static_cast<int>(m.Points.size());
+        m.Points.push_back(P[v]);
+      }
+    for (std::size_t f = 0; f < T.size(); ++f)
+      if (TAlive[f])
+        m.Triangles.push_back({ map[T[f][0]], map[T[f][1]], map[T[f][2]] });
+    return m;
+  }
+
+  struct NewTri
+  {
+    int Ids[3];
+    Vec3 Pts[3];
+    Vec3 N;
+  };
+
+  const TriangleTree& Input;
+  SimplifyOptions Opt;
+  Progress* Prog;
+  std::vector<Vec3> P;
+  std::vector<Triangle> T;
+  std::vector<char> VAlive, TAlive;
+  std::vector<std::vector<int>> VT;
+  std::vector<Quadric> Q;
+  std::vector<unsigned> Ver;
+  std::vector<unsigned> Mark;
+  std::vector<unsigned> Seen;
+  unsigned QueryId = 0;
+  std::vector<NewTri> NewTris;
+  int AliveVertices = 0, AliveTriangles = 0, GridTriangles = 0;
+  CageGrid Grid;
+  std::priority_queue<Entry> Heap;
+  std::unordered_set<std::uint64_t> Blocked;
+  SimplifyResult Stats;
+};
+
+} // namespace
+
+SimplifyResult simplifyEnvelope(const TriangleMesh& envelope, const TriangleTree& inputTree,
+  const SimplifyOptions& options, Progress* progress)
+{
+  if (envelope.Triangles.empty())
+  {
+    SimplifyResult r;
+    r.StopReason = "empty envelope";
+    return r;
+  }
+  Simplifier s(envelope, inputTree, options, progress);
+  return s.run();
+}
+
+} // namespace sdfcage

@@ -1,0 +1,61 @@
+// SDFCage — Core: constrained QEM simplification (paper §3.2): collapse edges of the verified
+// envelope down to exactly N vertices while every step keeps the cage strictly outside the input
+// and free of self-intersections.
+#pragma once
+
+#include "Mesh.h"
+
+#include <string>
+
+namespace sdfcage
+{
+
+class Progress;
+class TriangleTree;
+
+/// Lengths in unit-sphere units.
+struct SimplifyOptions
+{
+  /// Stop at exactly this many vertices (>= 4 per component).
+  int TargetVertices = 500;
+  /// Every cage triangle keeps at least this distance from every input triangle.
+  double Clearance = 0.0025;
+  /// Every new cage triangle keeps at least this distance from every cage triangle that shares
+  /// no vertex with it; triangles sharing a vertex or an edge must not intersect or fold.
+  /// 0 = Clearance / 4 (the dense envelope's own 2-ring neighbours are closer than Clearance).
+  double SelfClearance = 0.0;
+  /// Needle bound: a new triangle's quality 4*sqrt(3)*area / (sum of squared edges), 1 for
+  /// equilateral, must be at least this (0.02 is a minimum angle of roughly 0.7 degrees).
+  double MinimumTriangleQuality = 0.02;
+  /// A new triangle's normal must stay within this angle of the triangle it replaces: cos = 0.2
+  /// (about 78 degrees) forbids flips and near-flips.
+  double MinimumNormalCosine = 0.2;
+  /// Gradient steps on Psi (eq. 5-6) to move an infeasible placement into the feasible region.
+  int PlacementIterations = 8;
+
+  double selfClearance() const { return SelfClearance > 0 ? SelfClearance : Clearance / 4; }
+};
+
+struct SimplifyResult
+{
+  TriangleMesh Cage;          ///< unit-sphere units
+  int VerticesReached = 0;
+  bool ReachedTarget = false;
+  bool Cancelled = false;
+  std::string StopReason;     ///< why it stopped before the target (empty when reached)
+  long long Collapses = 0;
+  long long RejectedInput = 0;     ///< candidate collapses vetoed by the input clearance
+  long long RejectedSelf = 0;      ///< ... by self-intersection / self clearance
+  long long RejectedTopology = 0;  ///< ... by the link condition
+  long long RejectedShape = 0;     ///< ... by flips or needles
+  long long Relocated = 0;         ///< placements made feasible by the Psi descent
+  double Seconds = 0.0;
+};
+
+/// Simplifies `envelope` (closed, outward, unit units, at least `Clearance` from the input) down
+/// to options.TargetVertices vertices. `inputTree` indexes the normalized input. Deterministic:
+/// one sequential collapse order, independent of the thread count.
+SimplifyResult simplifyEnvelope(const TriangleMesh& envelope, const TriangleTree& inputTree,
+  const SimplifyOptions& options, Progress* progress = nullptr);
+
+} // namespace sdfcage
