@@ -147,13 +147,13 @@ HeaderKind ClassifyHeader(const std::string& token)
   {
     return HeaderKind::Invalid;
   }
-  if (std::isdigit(static_cast<unsigned char>(token[0])) || token[0] == '+')
+  const bool endsWithOFF = token.size() >= 3 && token.compare(token.size() - 3, 3, "OFF") == 0;
+  if (!endsWithOFF)
   {
-    return HeaderKind::Counts;
-  }
-  if (token.size() < 3 || token.compare(token.size() - 3, 3, "OFF") != 0)
-  {
-    return HeaderKind::Invalid;
+    // no keyword: the file starts directly with the counts
+    return std::isdigit(static_cast<unsigned char>(token[0])) || token[0] == '+'
+      ? HeaderKind::Counts
+      : HeaderKind::Invalid;
   }
   std::string prefix = token.substr(0, token.size() - 3);
   bool unsupported = false;

@@ -278,6 +278,7 @@ vtkSDFCageFilter::vtkSDFCageFilter()
   this->IsoValue = defaults.IsoValue;
   this->VoxelSize = defaults.VoxelSize;
   this->MinimumClearance = defaults.MinimumClearance;
+  this->Adaptivity = defaults.Adaptivity;
   this->MaximumRefinements = defaults.MaximumRefinements;
   this->GenerateDistanceField = defaults.KeepDistanceField ? 1 : 0;
   this->NumberOfThreads = defaults.NumberOfThreads;
@@ -393,6 +394,7 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
     options.Envelope.IsoValue = this->IsoValue;
     options.Envelope.VoxelSize = this->VoxelSize;
     options.Envelope.MinimumClearance = this->MinimumClearance;
+    options.Envelope.Adaptivity = this->Adaptivity;
     options.Envelope.MaximumRefinements = this->MaximumRefinements;
     options.Envelope.KeepDistanceField = this->GenerateDistanceField != 0;
     options.Envelope.NumberOfThreads = this->NumberOfThreads;
@@ -503,6 +505,7 @@ void vtkSDFCageFilter::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "IsoValue: " << this->IsoValue << "\n";
   os << indent << "VoxelSize: " << this->VoxelSize << "\n";
   os << indent << "MinimumClearance: " << this->MinimumClearance << "\n";
+  os << indent << "Adaptivity: " << this->Adaptivity << "\n";
   os << indent << "MaximumRefinements: " << this->MaximumRefinements << "\n";
   os << indent << "GenerateDistanceField: " << (this->GenerateDistanceField ? "On" : "Off")
      << "\n";
