@@ -1,0 +1,677 @@
+// SDFCage — tests of vtkSDFCageFilter: closed enclosing output, results, errors, empty input,
+// abort, distance field, parameters, real meshes.
+#include "SDFCageTestUtilities.h"
+
+#include "vtkAlgorithm.h"
+#include "vtkCellArray.h"
+#include "vtkDataObject.h"
+#include "vtkDoubleArray.h"
+#include "vtkExecutive.h"
+#include "vtkFieldData.h"
+#include "vtkFloatArray.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkIntArray.h"
+#include "vtkMath.h"
+#include "vtkOFFReader.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkSDFCageFilter.h"
+#include "vtkSphereSource.h"
+#include "vtkStringArray.h"
+#include "vtkTriangleFilter.h"
+
+#include "Envelope.h" // Core: the default options the filter must mirror
+#include "Shapes.h"   // Core: the built-in test shape
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+
+namespace sdfcage_test
+{
+namespace
+{
+
+vtkSmartPointer<vtkPolyData> FromTriangleMesh(const sdfcage::TriangleMesh& mesh)
+{
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  for (const sdfcage::Vec3& p : mesh.Points)
+  {
+    points->InsertNextPoint(p[0], p[1], p[2]);
+  }
+  vtkNew<vtkCellArray> polys;
+  for (const sdfcage::Triangle& t : mesh.Triangles)
+  {
+    const vtkIdType ids[3] = { t[0], t[1], t[2] };
+    polys->InsertNextCell(3, ids);
+  }
+  auto result = vtkSmartPointer<vtkPolyData>::New();
+  result->SetPoints(points);
+  result->SetPolys(polys);
+  return result;
+}
+
+vtkSmartPointer<vtkPolyData> MakeCenteredSphere(const double center[3], double radius, int res)
+{
+  vtkNew<vtkSphereSource> sphere;
+  sphere->SetCenter(center[0], center[1], center[2]);
+  sphere->SetRadius(radius);
+  sphere->SetThetaResolution(res);
+  sphere->SetPhiResolution(res);
+  vtkNew<vtkTriangleFilter> triangles;
+  triangles->SetInputConnection(sphere->GetOutputPort());
+  triangles->Update();
+  auto result = vtkSmartPointer<vtkPolyData>::New();
+  result->ShallowCopy(triangles->GetOutput());
+  return result;
+}
+
+std::string FieldString(vtkPolyData* data, const char* name)
+{
+  auto* array = vtkStringArray::SafeDownCast(data->GetFieldData()->GetAbstractArray(name));
+  return array && array->GetNumberOfValues() > 0 ? array->GetValue(0) : std::string("<missing>");
+}
+
+double FieldNumber(vtkPolyData* data, const char* name)
+{
+  vtkDataArray* array = data->GetFieldData()->GetArray(name);
+  return array && array->GetNumberOfTuples() > 0 ? array->GetTuple1(0) : vtkMath::Nan();
+}
+
+bool IsEmpty(vtkDataObject* data)
+{
+  if (auto* pd = vtkPolyData::SafeDownCast(data))
+  {
+    return pd->GetNumberOfPoints() == 0 && pd->GetNumberOfCells() == 0;
+  }
+  if (auto* image = vtkImageData::SafeDownCast(data))
+  {
+    return image->GetNumberOfPoints() == 0;
+  }
+  return data == nullptr;
+}
+
+/// Everything a successful run must satisfy: a closed cage and envelope around the input, with
+/// DistanceToInput no smaller than the measured clearance, and consistent results.
+void CheckSuccessfulRun(Checker& c, vtkSDFCageFilter* filter, vtkPolyData* input)
+{
+  c.Check(std::string(filter->GetStatusString()) == "Ok",
+    std::string("status Ok, got ") + filter->GetStatusString() + ": " +
+      filter->GetLastErrorMessage());
+  c.Check(filter->GetEnclosureVerified(), "EnclosureVerified");
+  c.Check(filter->GetMeasuredClearance() > 0, "MeasuredClearance > 0");
+  c.Check(filter->GetMeasuredClearanceRelative() > 0, "MeasuredClearanceRelative > 0");
+  const double delta =
+    filter->GetMinimumClearance() > 0 ? filter->GetMinimumClearance() : filter->GetIsoValue() / 4;
+  c.Check(filter->GetMeasuredClearanceRelative() >= delta * (1 - 1e-9),
+    "relative clearance " + Str(filter->GetMeasuredClearanceRelative()) + " >= delta " +
+      Str(delta));
+  c.Check(filter->GetVoxelSizeUsed() > 0, "VoxelSizeUsed > 0");
+  c.Check(filter->GetTotalTime() > 0, "TotalTime > 0");
+  c.Check(filter->GetTotalTime() + 1e-9 >= filter->GetDistanceFieldTime(),
+    "TotalTime >= DistanceFieldTime");
+  c.Check(std::string(filter->GetLastErrorMessage()).empty(), "no error message");
+
+  double inBounds[6];
+  input->GetBounds(inBounds);
+  for (int port = 0; port < 2; ++port)
+  {
+    const std::string name = port == 0 ? "cage" : "envelope";
+    vtkPolyData* out = filter->GetOutput(port);
+    if (!c.Check(out && out->GetNumberOfPoints() > 0 && out->GetNumberOfPolys() > 0,
+          name + " is not empty"))
+    {
+      continue;
+    }
+    c.Check(CountOpenEdges(out) == 0, name + " is closed and manifold (no boundary or "
+                                             "non-manifold edges)");
+    double outBounds[6];
+    out->GetBounds(outBounds);
+    for (int a = 0; a < 3; ++a)
+    {
+      c.Check(outBounds[2 * a] < inBounds[2 * a] && outBounds[2 * a + 1] > inBounds[2 * a + 1],
+        name + " bounds strictly contain the input's on axis " + Str(a));
+    }
+    auto* distance =
+      vtkDoubleArray::SafeDownCast(out->GetPointData()->GetArray("DistanceToInput"));
+    if (c.Check(distance != nullptr, name + " has a double array DistanceToInput") &&
+      c.Check(distance->GetNumberOfTuples() == out->GetNumberOfPoints(),
+        name + " DistanceToInput has one value per point"))
+    {
+      double range[2];
+      distance->GetRange(range);
+      c.Check(range[0] >= filter->GetMeasuredClearance() * (1 - 1e-9),
+        name + " min DistanceToInput " + Str(range[0]) + " >= MeasuredClearance " +
+          Str(filter->GetMeasuredClearance()));
+    }
+  }
+
+  vtkPolyData* cage = filter->GetOutput(0);
+  c.Check(FieldString(cage, "Status") == "Ok", "field data Status = Ok");
+  c.Check(FieldNumber(cage, "EnclosureVerified") == 1, "field data EnclosureVerified = 1");
+  c.Check(FieldNumber(cage, "MeasuredClearance") == filter->GetMeasuredClearance(),
+    "field data MeasuredClearance equals the getter");
+  c.Check(FieldNumber(cage, "EnvelopeGenus") == filter->GetEnvelopeGenus(),
+    "field data EnvelopeGenus equals the getter");
+  for (const char* name : { "ValidationTime", "DistanceFieldTime", "IsosurfaceTime",
+         "VerificationTime", "TotalTime", "MeasuredClearanceRelative", "RemovedPockets",
+         "VoxelSizeUsed", "InputWasFlipped" })
+  {
+    c.Check(!std::isnan(FieldNumber(cage, name)), std::string("field data has ") + name);
+  }
+  if (!filter->GetGenerateDistanceField())
+  {
+    c.Check(IsEmpty(filter->GetOutputDataObject(2)), "no distance field unless requested");
+  }
+}
+
+void PrintResults(vtkSDFCageFilter* filter)
+{
+  vtkPolyData* cage = filter->GetOutput(0);
+  std::cout << "  status " << filter->GetStatusString() << ", cage " << cage->GetNumberOfPoints()
+            << " points / " << cage->GetNumberOfPolys() << " triangles, genus "
+            << filter->GetEnvelopeGenus() << ", pockets removed " << filter->GetRemovedPockets()
+            << ", clearance " << filter->GetMeasuredClearance() << " (relative "
+            << filter->GetMeasuredClearanceRelative() << "), voxel "
+            << filter->GetVoxelSizeUsed() << ", time " << filter->GetTotalTime() << " s\n";
+}
+
+} // namespace
+
+//------------------------------------------------------------------------------
+int TestSphere(const Context&)
+{
+  Checker c("Sphere");
+  // Off-origin and not unit-sized, so that the mapping back to input coordinates is exercised.
+  const double center[3] = { 10.0, -3.0, 2.0 };
+  const double radius = 2.5;
+  vtkSmartPointer<vtkPolyData> input = MakeCenteredSphere(center, radius, 32);
+
+  vtkNew<vtkSDFCageFilter> filter;
+  vtkNew<MessageRecorder> messages;
+  messages->Watch(filter);
+  messages->Watch(filter->GetExecutive());
+  filter->SetInputData(input);
+  filter->Update();
+  PrintResults(filter);
+
+  c.Check(messages->Errors.empty(), "no errors" + (messages->Errors.empty() ? std::string() : ": " + messages->Errors[0]));
+  c.Check(messages->Warnings.empty(), "no warnings for a clean triangle sphere");
+  CheckSuccessfulRun(c, filter, input);
+  c.Check(!filter->GetInputWasFlipped(), "an outward sphere is not flipped");
+  c.Check(filter->GetEnvelopeGenus() == 0, "the envelope of a sphere has genus 0");
+
+  // The normalization maps the sphere onto the unit sphere: input lengths are radius x relative.
+  c.Check(std::abs(filter->GetMeasuredClearance() -
+            filter->GetMeasuredClearanceRelative() * radius) <=
+      1e-6 * filter->GetMeasuredClearance(),
+    "MeasuredClearance = MeasuredClearanceRelative x radius");
+
+  // DistanceToInput is in input units: for a faceted sphere it is close to |p - center| - R.
+  vtkPolyData* cage = filter->GetOutput(0);
+  auto* distance = vtkDoubleArray::SafeDownCast(cage->GetPointData()->GetArray("DistanceToInput"));
+  if (distance)
+  {
+    double worst = 0;
+    for (vtkIdType i = 0; i < cage->GetNumberOfPoints(); ++i)
+    {
+      double p[3];
+      cage->GetPoint(i, p);
+      const double expected = std::sqrt(vtkMath::Distance2BetweenPoints(p, center)) - radius;
+      worst = std::max(worst, std::abs(distance->GetValue(i) - expected));
+    }
+    // facets deviate from the true sphere by < 1% of R at this resolution
+    c.Check(worst < 0.01 * radius,
+      "DistanceToInput matches |p - center| - R within facet error, worst " + Str(worst));
+    double range[2];
+    distance->GetRange(range);
+    c.Check(range[1] < 0.05 * radius, "the envelope hugs the sphere (max distance " +
+        Str(range[1]) + " < 5% of R)");
+  }
+
+  // Same input, second update without changes: no re-execution, same result.
+  const vtkIdType points = cage->GetNumberOfPoints();
+  filter->Update();
+  c.Check(filter->GetOutput(0)->GetNumberOfPoints() == points, "stable on re-update");
+  return c.Result();
+}
+
+//------------------------------------------------------------------------------
+int TestBuiltinShape(const Context&)
+{
+  Checker c("BuiltinShape");
+  vtkSmartPointer<vtkPolyData> input = FromTriangleMesh(sdfcage::makeBuiltinShape());
+  vtkNew<vtkSDFCageFilter> filter;
+  vtkNew<MessageRecorder> messages;
+  messages->Watch(filter);
+  messages->Watch(filter->GetExecutive());
+  filter->SetInputData(input);
+  filter->Update();
+  PrintResults(filter);
+  c.Check(messages->Errors.empty(), "no errors" + (messages->Errors.empty() ? std::string() : ": " + messages->Errors[0]));
+  CheckSuccessfulRun(c, filter, input);
+  // A torus beside a sphere: the torus hole is far wider than the offset, so genus >= 1.
+  c.Check(filter->GetEnvelopeGenus() >= 1, "the torus' hole survives (genus >= 1)");
+  return c.Result();
+}
+
+//------------------------------------------------------------------------------
+int TestOpenInput(const Context&)
+{
+  Checker c("OpenInput");
+
+  // A sphere with one triangle removed: 3 boundary edges.
+  vtkSmartPointer<vtkPolyData> sphere = MakeSphere(1.0, 16);
+  vtkNew<vtkCellArray> polys;
+  {
+    vtkCellArray* all = sphere->GetPolys();
+    vtkIdType npts = 0;
+    const vtkIdType* pts = nullptr;
+    for (vtkIdType cell = 1; cell < all->GetNumberOfCells(); ++cell) // skip cell 0
+    {
+      all->GetCellAtId(cell, npts, pts);
+      polys->InsertNextCell(npts, pts);
+    }
+  }
+  vtkNew<vtkPolyData> holed;
+  holed->SetPoints(sphere->GetPoints());
+  holed->SetPolys(polys);
+
+  vtkNew<vtkSDFCageFilter> filter;
+  vtkNew<MessageRecorder> messages;
+  messages->Watch(filter);
+  messages->Watch(filter->GetExecutive());
+  filter->SetInputData(holed);
+  filter->Update();
+  std::cout << "  error: " << (messages->Errors.empty() ? "(none)" : messages->Errors[0]) << "\n";
+  c.Check(messages->ErrorContains("boundary"), "the error names the boundary edges");
+  c.Check(messages->ErrorContains("3 boundary"), "the error gives their count (3)");
+  c.Check(std::string(filter->GetStatusString()) == "InvalidInput", "status InvalidInput");
+  c.Check(std::string(filter->GetLastErrorMessage()).find("boundary") != std::string::npos,
+    "GetLastErrorMessage names the defect");
+  for (int port = 0; port < 3; ++port)
+  {
+    c.Check(IsEmpty(filter->GetOutputDataObject(port)), "output " + Str(port) + " is empty");
+  }
+  c.Check(FieldString(filter->GetOutput(0), "Status") == "InvalidInput",
+    "field data Status = InvalidInput on the empty cage");
+
+  // A single triangle.
+  vtkNew<vtkPoints> points;
+  points->InsertNextPoint(0, 0, 0);
+  points->InsertNextPoint(1, 0, 0);
+  points->InsertNextPoint(0, 1, 0);
+  vtkNew<vtkCellArray> one;
+  const vtkIdType tri[3] = { 0, 1, 2 };
+  one->InsertNextCell(3, tri);
+  vtkNew<vtkPolyData> triangle;
+  triangle->SetPoints(points);
+  triangle->SetPolys(one);
+  messages->Clear();
+  filter->SetInputData(triangle);
+  filter->Update();
+  c.Check(messages->ErrorContains("boundary"), "a single triangle is rejected as open");
+  c.Check(IsEmpty(filter->GetOutput(0)), "empty cage for a single triangle");
+
+  // The filter recovers: a closed input afterwards succeeds without errors.
+  messages->Clear();
+  vtkSmartPointer<vtkPolyData> closed = MakeSphere(1.0, 16);
+  filter->SetInputData(closed);
+  filter->SetIsoValue(0.04); // coarse and fast: only recovery is tested here
+  filter->Update();
+  c.Check(messages->Errors.empty(), "no error after fixing the input");
+  c.Check(std::string(filter->GetStatusString()) == "Ok", "status Ok after fixing the input");
+  c.Check(filter->GetOutput(0)->GetNumberOfPoints() > 0, "non-empty cage after fixing the input");
+  return c.Result();
+}
+
+//------------------------------------------------------------------------------
+int TestNoSurface(const Context&)
+{
+  Checker c("NoSurface");
+  vtkNew<vtkPoints> points;
+  vtkNew<vtkCellArray> verts;
+  for (int i = 0; i < 10; ++i)
+  {
+    const vtkIdType id = points->InsertNextPoint(i, 0.5 * i, 0);
+    verts->InsertNextCell(1, &id);
+  }
+  vtkNew<vtkPolyData> cloud;
+  cloud->SetPoints(points);
+  cloud->SetVerts(verts);
+
+  vtkNew<vtkSDFCageFilter> filter;
+  vtkNew<MessageRecorder> messages;
+  messages->Watch(filter);
+  messages->Watch(filter->GetExecutive());
+  filter->SetInputData(cloud);
+  filter->Update();
+  std::cout << "  error: " << (messages->Errors.empty() ? "(none)" : messages->Errors[0]) << "\n";
+  c.Check(messages->ErrorContains("no polygons"), "a point cloud is rejected (no polygons)");
+  c.Check(IsEmpty(filter->GetOutput(0)), "empty cage");
+  return c.Result();
+}
+
+//------------------------------------------------------------------------------
+int TestEmptyInput(const Context&)
+{
+  Checker c("EmptyInput");
+  vtkNew<vtkSDFCageFilter> filter;
+  vtkNew<MessageRecorder> messages;
+  messages->Watch(filter);
+  messages->Watch(filter->GetExecutive());
+
+  vtkNew<vtkPolyData> empty;
+  filter->SetInputData(empty);
+  filter->Update();
+  c.Check(messages->Errors.empty() && messages->Warnings.empty(), "no error or warning");
+  c.Check(std::string(filter->GetStatusString()) == "EmptyInput", "status EmptyInput");
+  for (int port = 0; port < 3; ++port)
+  {
+    c.Check(IsEmpty(filter->GetOutputDataObject(port)), "output " + Str(port) + " is empty");
+  }
+
+  // Points but no cells is empty too.
+  vtkNew<vtkPoints> points;
+  points->InsertNextPoint(0, 0, 0);
+  vtkNew<vtkPolyData> pointsOnly;
+  pointsOnly->SetPoints(points);
+  filter->SetInputData(pointsOnly);
+  filter->Update();
+  c.Check(messages->Errors.empty(), "no error for points without cells");
+  c.Check(IsEmpty(filter->GetOutput(0)), "empty cage for points without cells");
+  return c.Result();
+}
+
+//------------------------------------------------------------------------------
+namespace
+{
+/// Aborts the filter once its progress reaches `Threshold`.
+class AbortAt : public vtkCommand
+{
+public:
+  static AbortAt* New() { return new AbortAt; }
+  void Execute(vtkObject* caller, unsigned long, void* callData) override
+  {
+    const double progress = callData ? *static_cast<double*>(callData) : 0.0;
+    ++this->Events;
+    if (progress >= this->Threshold && !this->Fired)
+    {
+      this->Fired = true;
+      this->FiredAt = std::chrono::steady_clock::now();
+      vtkAlgorithm::SafeDownCast(caller)->SetAbortExecute(1);
+    }
+  }
+  double Threshold = 0.0;
+  bool Fired = false;
+  int Events = 0;
+  std::chrono::steady_clock::time_point FiredAt;
+};
+} // namespace
+
+int TestAbort(const Context&)
+{
+  Checker c("Abort");
+  // Dense enough that a run takes a while.
+  vtkSmartPointer<vtkPolyData> input = MakeSphere(1.0, 160);
+  using Clock = std::chrono::steady_clock;
+
+  // Reference run.
+  double fullSeconds = 0;
+  {
+    vtkNew<vtkSDFCageFilter> filter;
+    vtkNew<AbortAt> progress; // never fires
+    progress->Threshold = 2.0;
+    filter->AddObserver(vtkCommand::ProgressEvent, progress);
+    filter->SetInputData(input);
+    const auto t0 = Clock::now();
+    filter->Update();
+    fullSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
+    std::cout << "  full run " << fullSeconds << " s, " << progress->Events
+              << " progress events\n";
+    c.Check(std::string(filter->GetStatusString()) == "Ok", "reference run succeeds");
+    c.Check(progress->Events >= 3, "progress is reported during the run");
+    c.Check(progress->Events < 1000, "progress events are throttled (" + Str(progress->Events) + ")");
+  }
+
+  for (double threshold : { 0.0, 0.3 })
+  {
+    vtkNew<vtkSDFCageFilter> filter;
+    vtkNew<MessageRecorder> messages;
+    messages->Watch(filter);
+    messages->Watch(filter->GetExecutive());
+    vtkNew<AbortAt> progress;
+    progress->Threshold = threshold;
+    filter->AddObserver(vtkCommand::ProgressEvent, progress);
+    filter->SetInputData(input);
+    filter->Update();
+    const auto t1 = Clock::now();
+    const std::string tag = "abort at " + Str(threshold) + ": ";
+    if (!progress->Fired)
+    {
+      std::cout << "  " << tag << "progress never reached the threshold\n";
+      continue;
+    }
+    const double afterAbort = std::chrono::duration<double>(t1 - progress->FiredAt).count();
+    std::cout << "  " << tag << "status " << filter->GetStatusString() << ", returned "
+              << afterAbort << " s after the abort request\n";
+    c.Check(messages->Errors.empty(), tag + "no error");
+    const std::string status = filter->GetStatusString();
+    c.Check(status == "Cancelled" || status == "Ok", tag + "status Cancelled (or Ok)");
+    vtkPolyData* cage = filter->GetOutput(0);
+    if (status == "Cancelled")
+    {
+      c.Check(IsEmpty(cage), tag + "empty cage after cancel");
+      c.Check(IsEmpty(filter->GetOutput(1)), tag + "empty envelope after cancel");
+    }
+    else
+    {
+      c.Check(cage->GetNumberOfPoints() > 0 && CountOpenEdges(cage) == 0,
+        tag + "a finished run is valid");
+    }
+    // "Promptly": well before a full run would have finished.
+    c.Check(afterAbort < 0.5 * fullSeconds + 0.25,
+      tag + "returns promptly (" + Str(afterAbort) + " s vs full " + Str(fullSeconds) + " s)");
+
+    // A cancelled filter runs normally next time (coarse grid: only the recovery matters).
+    // VTK 9.1 clears the abort flag when the next execution starts; ParaView 5.11's VTK keeps it
+    // set until it is cleared, so clear it explicitly (right for both).
+    filter->RemoveObservers(vtkCommand::ProgressEvent);
+    filter->SetAbortExecute(0);
+    filter->SetIsoValue(0.04);
+    filter->Update();
+    c.Check(std::string(filter->GetStatusString()) == "Ok" &&
+        filter->GetOutput(0)->GetNumberOfPoints() > 0,
+      tag + "the next update after a cancel succeeds");
+    c.Check(messages->Errors.empty(), tag + "no error in the next update");
+  }
+  return c.Result();
+}
+
+//------------------------------------------------------------------------------
+int TestDistanceField(const Context&)
+{
+  Checker c("DistanceField");
+  const double center[3] = { 0.0, 0.0, 0.0 };
+  const double radius = 2.0;
+  vtkSmartPointer<vtkPolyData> input = MakeCenteredSphere(center, radius, 32);
+  vtkNew<vtkSDFCageFilter> filter;
+  vtkNew<MessageRecorder> messages;
+  messages->Watch(filter);
+  messages->Watch(filter->GetExecutive());
+  filter->SetInputData(input);
+  // A coarse grid keeps the dense image small (about 100^3 values instead of 400^3).
+  filter->SetIsoValue(0.04);
+  filter->GenerateDistanceFieldOn();
+  filter->Update();
+  c.Check(messages->Errors.empty(), "no errors");
+  CheckSuccessfulRun(c, filter, input);
+
+  c.Check(std::string(filter->GetOutputDataObject(2)->GetClassName()) == "vtkImageData",
+    "output 2 is a vtkImageData");
+  vtkImageData* image = vtkImageData::SafeDownCast(filter->GetOutputDataObject(2));
+  if (!c.Check(image && image->GetNumberOfPoints() > 0, "the distance field is not empty"))
+  {
+    return c.Result();
+  }
+  int dims[3];
+  image->GetDimensions(dims);
+  double spacing[3], bounds[6];
+  image->GetSpacing(spacing);
+  image->GetBounds(bounds);
+  std::cout << "  image " << dims[0] << "x" << dims[1] << "x" << dims[2] << ", spacing "
+            << spacing[0] << ", bounds [" << bounds[0] << ", " << bounds[1] << "]\n";
+  vtkDataArray* sd = image->GetPointData()->GetArray("SignedDistance");
+  if (!c.Check(sd != nullptr, "point array SignedDistance"))
+  {
+    return c.Result();
+  }
+  // The grid covers the input (and the envelope).
+  for (int a = 0; a < 3; ++a)
+  {
+    c.Check(bounds[2 * a] < -radius && bounds[2 * a + 1] > radius,
+      "the grid covers the input on axis " + Str(a));
+  }
+  auto valueAt = [&](double x, double y, double z) {
+    const double p[3] = { x, y, z };
+    const vtkIdType id = image->FindPoint(const_cast<double*>(p));
+    return id < 0 ? vtkMath::Nan() : sd->GetTuple1(id);
+  };
+  const double inside = valueAt(0, 0, 0);
+  const double outside = valueAt(bounds[1], bounds[3], bounds[5]);
+  std::cout << "  SignedDistance at the center " << inside << ", at the grid corner " << outside
+            << "\n";
+  c.Check(inside < 0, "negative inside (at the center)");
+  c.Check(outside > 0, "positive outside (at the grid corner)");
+  // Near the surface the values are distances in input units: 0.02 R outside the sphere. The
+  // nearest grid point is up to sqrt(3)/2 spacing away, and the facets are within 0.5% of R.
+  const double probe = valueAt(radius * 1.02, 0, 0);
+  const double tolerance = spacing[0] + 0.01 * radius;
+  c.Check(std::abs(probe - 0.02 * radius) < tolerance,
+    "value near the surface in input units: " + Str(probe) + " vs " + Str(0.02 * radius) +
+      " (tolerance " + Str(tolerance) + ")");
+  const double probeIn = valueAt(radius * 0.97, 0, 0);
+  c.Check(probeIn < 0, "negative just inside the surface (" + Str(probeIn) + ")");
+
+  // Turned off again: the image output is emptied.
+  filter->GenerateDistanceFieldOff();
+  filter->Update();
+  c.Check(IsEmpty(filter->GetOutputDataObject(2)), "image empty once GenerateDistanceField is off");
+  return c.Result();
+}
+
+//------------------------------------------------------------------------------
+int TestParameters(const Context&)
+{
+  Checker c("Parameters");
+  vtkNew<vtkSDFCageFilter> filter;
+  const sdfcage::EnvelopeOptions core;
+  c.Check(filter->GetIsoValue() == core.IsoValue, "IsoValue default = Core's");
+  c.Check(filter->GetVoxelSize() == core.VoxelSize, "VoxelSize default = Core's");
+  c.Check(filter->GetMinimumClearance() == core.MinimumClearance, "MinimumClearance default = Core's");
+  c.Check(filter->GetAdaptivity() == core.Adaptivity, "Adaptivity default = Core's");
+  c.Check(filter->GetMaximumRefinements() == core.MaximumRefinements,
+    "MaximumRefinements default = Core's");
+  c.Check((filter->GetGenerateDistanceField() != 0) == core.KeepDistanceField,
+    "GenerateDistanceField default = Core's");
+  c.Check(filter->GetNumberOfThreads() == core.NumberOfThreads, "NumberOfThreads default = Core's");
+  c.Check(filter->GetIsoValue() == 0.01, "IsoValue default is the paper's 0.01");
+
+  filter->SetIsoValue(-1.0);
+  c.Check(filter->GetIsoValue() > 0, "IsoValue is clamped to a positive value");
+  filter->SetVoxelSize(-1.0);
+  c.Check(filter->GetVoxelSize() == 0, "VoxelSize is clamped to >= 0");
+  filter->SetNumberOfThreads(-3);
+  c.Check(filter->GetNumberOfThreads() == 0, "NumberOfThreads is clamped to >= 0");
+
+  c.Check(filter->GetNumberOfOutputPorts() == 3, "three output ports");
+  c.Check(std::string(filter->GetOutputPortInformation(2)->Get(vtkDataObject::DATA_TYPE_NAME())) ==
+      "vtkImageData",
+    "output port 2 is declared as vtkImageData");
+  c.Check(std::string(filter->GetOutputPortInformation(0)->Get(vtkDataObject::DATA_TYPE_NAME())) ==
+      "vtkPolyData",
+    "output port 0 is declared as vtkPolyData");
+  std::ostringstream print;
+  filter->Print(print);
+  c.Check(print.str().find("IsoValue") != std::string::npos, "PrintSelf lists the parameters");
+
+  // Explicit (non-automatic) values are honoured: a coarser grid and an explicit clearance.
+  vtkSmartPointer<vtkPolyData> input = MakeSphere(1.0, 24);
+  vtkNew<vtkSDFCageFilter> explicitFilter;
+  explicitFilter->SetInputData(input);
+  explicitFilter->SetIsoValue(0.04);
+  explicitFilter->SetVoxelSize(0.02);
+  explicitFilter->SetMinimumClearance(0.005);
+  explicitFilter->SetNumberOfThreads(1);
+  explicitFilter->Update();
+  PrintResults(explicitFilter);
+  CheckSuccessfulRun(c, explicitFilter, input);
+  c.Check(explicitFilter->GetVoxelSizeUsed() <= 0.02 + 1e-12, "VoxelSizeUsed <= VoxelSize");
+
+  // Thread count does not change the result.
+  vtkNew<vtkSDFCageFilter> allThreads;
+  allThreads->SetInputData(input);
+  allThreads->SetIsoValue(0.04);
+  allThreads->SetVoxelSize(0.02);
+  allThreads->SetMinimumClearance(0.005);
+  allThreads->SetNumberOfThreads(0);
+  allThreads->Update();
+  vtkPolyData* a = explicitFilter->GetOutput(0);
+  vtkPolyData* b = allThreads->GetOutput(0);
+  bool same = a->GetNumberOfPoints() == b->GetNumberOfPoints() &&
+    a->GetNumberOfPolys() == b->GetNumberOfPolys();
+  for (vtkIdType i = 0; same && i < a->GetNumberOfPoints(); ++i)
+  {
+    double p[3], q[3];
+    a->GetPoint(i, p);
+    b->GetPoint(i, q);
+    same = p[0] == q[0] && p[1] == q[1] && p[2] == q[2];
+  }
+  c.Check(same, "identical cages with 1 thread and all threads");
+  return c.Result();
+}
+
+//------------------------------------------------------------------------------
+namespace
+{
+int RunOnDataFile(const Context& context, const char* name, const char* file)
+{
+  Checker c(name);
+  const std::string path = context.DataDir + "/" + file;
+  if (context.DataDir.empty() || !std::ifstream(path).good())
+  {
+    std::cout << "skipped: " << path << " not found (data folder absent)\n";
+    return Skipped;
+  }
+  vtkNew<vtkOFFReader> reader;
+  reader->SetFileName(path.c_str());
+  vtkNew<vtkSDFCageFilter> filter;
+  vtkNew<MessageRecorder> messages;
+  messages->Watch(filter);
+  messages->Watch(reader);
+  filter->SetInputConnection(reader->GetOutputPort());
+  filter->Update();
+  PrintResults(filter);
+  c.Check(messages->Errors.empty(),
+    "no errors" + (messages->Errors.empty() ? std::string() : ": " + messages->Errors[0]));
+  vtkPolyData* input = reader->GetOutput();
+  c.Check(input->GetNumberOfPolys() > 0, "the reader produced polygons");
+  CheckSuccessfulRun(c, filter, input);
+  return c.Result();
+}
+} // namespace
+
+int TestDataKnight(const Context& context)
+{
+  return RunOnDataFile(context, "DataKnight", "decimated-knight.off");
+}
+
+int TestDataBunnyOFF(const Context& context)
+{
+  return RunOnDataFile(context, "DataBunnyOFF", "bunny.off");
+}
+
+} // namespace sdfcage_test
