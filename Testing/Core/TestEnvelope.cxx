@@ -1,0 +1,361 @@
+// SDFCage — Testing: the verified envelope (buildEnvelope) and the pipeline (generateCage),
+// judged by the independent CGAL checker; cancellation and error paths.
+#include "CageGenerator.h"
+#include "Envelope.h"
+#include "ExactCheck.h"
+#include "Geometry.h"
+#include "Mesh.h"
+#include "Normalization.h"
+#include "Progress.h"
+#include "Shapes.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+#include <functional>
+#include <iostream>
+#include <limits>
+#include <mutex>
+#include <string>
+#include <vector>
+
+using namespace sdfcage;
+
+namespace
+{
+
+struct ShapeCase
+{
+  std::string Name;
+  std::function<TriangleMesh()> Make;
+  /// Topology the envelope must keep (-1: not checked; e.g. the built-in shape's parts are closer
+  /// than 2c, so a plain offset may fuse them until active points exist).
+  int Components;
+  int Genus;
+};
+
+std::vector<ShapeCase> shapeCases()
+{
+  return {
+    { "builtin", [] { return makeBuiltinShape(); }, -1, -1 },
+    { "sphere", [] { return makeSphere(Vec3(3, -1, 2), 5.0, 48, 24); }, 1, 0 },
+    { "torus", [] { return makeTorus(Vec3(0, 0, 0), 1.0, 0.35, 64, 24); }, 1, 1 },
+    { "two_boxes",
+      [] {
+        TriangleMesh m = makeBox(Vec3(0, 0, 0), Vec3(1, 1, 1));
+        appendMesh(m, makeBox(Vec3(1.5, 0, 0), Vec3(2.5, 1, 1)));
+        return m;
+      },
+      2, 0 },
+  };
+}
+
+/// Brute-force unsigned distance from p to a mesh.
+double bruteDistance(const TriangleMesh& mesh, const Vec3& p)
+{
+  double best = std::numeric_limits<double>::infinity();
+  for (const Triangle& t : mesh.Triangles)
+  {
+    best = std::min(best,
+      (p - closestPointOnTriangle(p, mesh.Points[t[0]], mesh.Points[t[1]], mesh.Points[t[2]])).norm());
+  }
+  return best;
+}
+
+/// The checks every verified envelope/cage must pass against its input (same coordinates).
+/// `delta`: the promised clearance; `limit`: exact measuring range (> the expected clearance).
+exact::ExactReport expectEncloses(const TriangleMesh& input, const TriangleMesh& cage, double delta,
+  double limit, const std::string& what)
+{
+  const exact::ExactReport r = exact::exactCheck(input, cage, limit);
+  std::cout << "[ exact    ] " << what << ": " << r.CageTriangles << " cage triangles vs "
+            << r.InputTriangles << " input triangles, clearance " << r.MinimumClearance
+            << " (promised " << delta << "), genus " << r.CageGenus << ", components "
+            << r.CageComponents << ", exactCheck " << r.Seconds << " s\n";
+  EXPECT_TRUE(r.Closed2Manifold) << what << ": boundary " << r.BoundaryEdges << ", non-manifold edges "
+                                 << r.NonManifoldEdges << ", vertices " << r.NonManifoldVertices;
+  EXPECT_EQ(r.SelfIntersections, 0) << what;
+  EXPECT_EQ(r.InputIntersections, 0) << what;
+  EXPECT_EQ(r.InputVerticesOutside, 0) << what;
+  EXPECT_EQ(r.DegenerateTriangles, 0) << what;
+  EXPECT_EQ(r.InconsistentEdges, 0) << what;
+  EXPECT_TRUE(r.Encloses) << what;
+  // The relative 1e-9 only absorbs rounding between unit-sphere and input coordinates.
+  EXPECT_GE(r.MinimumClearance, delta * (1.0 - 1e-9)) << what;
+  EXPECT_FALSE(r.ClearanceIsLowerBound) << what << ": no cage triangle within " << limit;
+  EXPECT_GT(signedVolume(cage), signedVolume(input)) << what << ": cage must face outward";
+  return r;
+}
+
+class EnvelopeShapes : public ::testing::TestWithParam<ShapeCase>
+{
+};
+
+std::string caseName(const ::testing::TestParamInfo<ShapeCase>& info)
+{
+  return info.param.Name;
+}
+
+} // namespace
+
+TEST_P(EnvelopeShapes, GenerateCageEnclosesExactly)
+{
+  const ShapeCase& shape = GetParam();
+  const TriangleMesh input = shape.Make();
+  CageOptions options;
+  const CageResult result = generateCage(PolygonMesh::fromTriangles(input), options);
+  ASSERT_EQ(result.State, Status::Ok) << statusName(result.State) << ": " << result.Message;
+  EXPECT_TRUE(result.Message.empty()) << result.Message;
+  EXPECT_TRUE(result.Defects.usable());
+  ASSERT_TRUE(result.EnclosureVerified);
+  ASSERT_FALSE(result.Cage.empty());
+  std::cout << "[ timing   ] " << shape.Name << ": total " << result.TotalSeconds << " s (SDF "
+            << result.DistanceFieldSeconds << ", isosurface " << result.IsosurfaceSeconds
+            << ", verification " << result.VerificationSeconds << "), voxel " << result.VoxelSizeUsed
+            << "\n";
+
+  const Normalization& n = result.Normalize;
+  const double delta = n.lengthToInput(options.Envelope.clearance());
+  const double limit = n.lengthToInput(2.0 * options.Envelope.IsoValue);
+  const exact::ExactReport r = expectEncloses(input, result.Cage, delta, limit, shape.Name + " cage");
+
+  // Core's own measurements agree with the independent ones.
+  EXPECT_NEAR(result.MinimumClearance, r.MinimumClearance, 1e-6 * r.MinimumClearance);
+  EXPECT_NEAR(result.MinimumClearanceRelative, n.lengthToUnit(result.MinimumClearance),
+    1e-9 * result.MinimumClearanceRelative);
+  EXPECT_EQ(result.EnvelopeGenus, r.CageGenus);
+  EXPECT_EQ(result.EnvelopeComponents, r.CageComponents);
+  if (shape.Components >= 0)
+  {
+    EXPECT_EQ(r.CageComponents, shape.Components) << "an offset must keep these parts apart";
+    EXPECT_EQ(r.CageGenus, shape.Genus) << "an offset must keep this genus";
+  }
+  EXPECT_LE(result.VoxelSizeUsed, options.Envelope.voxelSize() * (1 + 1e-12));
+  EXPECT_GT(result.VoxelSizeUsed, 0.0);
+
+  // Per-point distances: one per cage point, never below the exact triangle clearance, and equal
+  // to a brute-force distance (spot checks).
+  ASSERT_EQ(result.CageDistanceToInput.size(), result.Cage.Points.size());
+  const double smallest =
+    *std::min_element(result.CageDistanceToInput.begin(), result.CageDistanceToInput.end());
+  EXPECT_GE(smallest, r.MinimumClearance * (1.0 - 1e-9));
+  const std::size_t step = std::max<std::size_t>(1, result.Cage.Points.size() / 40);
+  for (std::size_t i = 0; i < result.Cage.Points.size(); i += step)
+  {
+    const double expected = bruteDistance(input, result.Cage.Points[i]);
+    EXPECT_NEAR(result.CageDistanceToInput[i], expected, 1e-9 * expected + 1e-12) << "point " << i;
+  }
+}
+
+TEST_P(EnvelopeShapes, BuildEnvelopeEnclosesExactly)
+{
+  const ShapeCase& shape = GetParam();
+  const TriangleMesh input = shape.Make();
+  const TriangleMesh unit = Normalization::fit(input).toUnit(input);
+  EnvelopeOptions options;
+  options.KeepDistanceField = true;
+  const EnvelopeResult env = buildEnvelope(unit, options);
+  ASSERT_EQ(env.State, Status::Ok) << statusName(env.State) << ": " << env.Message;
+  ASSERT_TRUE(env.EnclosureVerified);
+  const exact::ExactReport r = expectEncloses(unit, env.Envelope, options.clearance(),
+    2.0 * options.IsoValue, shape.Name + " envelope");
+  EXPECT_NEAR(env.MinimumClearance, r.MinimumClearance, 1e-6 * r.MinimumClearance);
+  EXPECT_EQ(env.Genus, r.CageGenus);
+  EXPECT_EQ(env.Components, r.CageComponents);
+  EXPECT_LE(env.VoxelSizeUsed, options.voxelSize() * (1 + 1e-12));
+  EXPECT_EQ(env.DistanceToInput.size(), env.Envelope.Points.size());
+
+  // The kept field is a dense grid covering the envelope.
+  const ScalarImage& f = env.DistanceField;
+  ASSERT_GT(f.Dimensions[0] * f.Dimensions[1] * f.Dimensions[2], 0);
+  EXPECT_EQ(f.Values.size(),
+    static_cast<std::size_t>(f.Dimensions[0]) * f.Dimensions[1] * f.Dimensions[2]);
+  EXPECT_GT(f.Spacing, 0.0);
+  const auto b = bounds(env.Envelope);
+  for (int k = 0; k < 3; ++k)
+  {
+    EXPECT_LE(f.Origin[k], b[0][k]);
+    EXPECT_GE(f.Origin[k] + f.Spacing * (f.Dimensions[k] - 1), b[1][k]);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Shapes, EnvelopeShapes, ::testing::ValuesIn(shapeCases()), caseName);
+
+TEST(Envelope, LargerIsoValueAndExplicitClearance)
+{
+  const TriangleMesh input = makeTorus(Vec3(0, 0, 0), 1.0, 0.35, 64, 24);
+  const TriangleMesh unit = Normalization::fit(input).toUnit(input);
+  EnvelopeOptions options;
+  options.IsoValue = 0.04;
+  options.MinimumClearance = 0.015;
+  const EnvelopeResult env = buildEnvelope(unit, options);
+  ASSERT_EQ(env.State, Status::Ok) << env.Message;
+  ASSERT_TRUE(env.EnclosureVerified);
+  EXPECT_DOUBLE_EQ(options.clearance(), 0.015);
+  const exact::ExactReport r =
+    expectEncloses(unit, env.Envelope, 0.015, 2.0 * options.IsoValue, "torus c=0.04");
+  EXPECT_EQ(r.CageGenus, 1);
+  EXPECT_LE(r.MinimumClearance, options.IsoValue); // the isosurface lies at distance about c
+}
+
+// --- cancellation ------------------------------------------------------------------------------
+
+namespace
+{
+
+/// Cancels through pollCancel() once the run has passed `Threshold` (0 = at once).
+class PollingCancel : public Progress
+{
+public:
+  explicit PollingCancel(double threshold)
+    : Threshold(threshold)
+  {
+  }
+  std::atomic<int> Polls{ 0 };
+
+protected:
+  bool pollCancel() override
+  {
+    ++Polls;
+    return this->overall() >= Threshold;
+  }
+
+private:
+  double Threshold;
+};
+
+/// Records every report; optionally calls cancel() from report() past a fraction.
+class Recorder : public Progress
+{
+public:
+  double CancelAt = 2.0; // never
+  std::mutex Lock;
+  std::vector<double> Fractions;
+  std::vector<std::string> Stages;
+
+protected:
+  void report(double overall, const std::string& stage) override
+  {
+    std::lock_guard<std::mutex> guard(Lock);
+    Fractions.push_back(overall);
+    if (Stages.empty() || Stages.back() != stage)
+    {
+      Stages.push_back(stage);
+    }
+    if (overall >= CancelAt)
+    {
+      this->cancel();
+    }
+  }
+};
+
+} // namespace
+
+TEST(Cancel, ImmediatelyGivesCancelled)
+{
+  PollingCancel progress(0.0);
+  const CageResult result =
+    generateCage(PolygonMesh::fromTriangles(makeBuiltinShape()), CageOptions(), &progress);
+  EXPECT_EQ(result.State, Status::Cancelled) << statusName(result.State) << ": " << result.Message;
+  EXPECT_FALSE(result.EnclosureVerified);
+  EXPECT_GT(progress.Polls.load(), 0);
+}
+
+TEST(Cancel, DuringTheDistanceFieldGivesCancelled)
+{
+  PollingCancel progress(0.05); // past validation, inside the SDF/isosurface stage
+  const CageResult result =
+    generateCage(PolygonMesh::fromTriangles(makeBuiltinShape()), CageOptions(), &progress);
+  EXPECT_EQ(result.State, Status::Cancelled) << statusName(result.State) << ": " << result.Message;
+  EXPECT_FALSE(result.EnclosureVerified);
+}
+
+TEST(Cancel, FromReportLateInTheRunGivesCancelled)
+{
+  Recorder progress;
+  progress.CancelAt = 0.75; // inside verification
+  const CageResult result =
+    generateCage(PolygonMesh::fromTriangles(makeBuiltinShape()), CageOptions(), &progress);
+  EXPECT_EQ(result.State, Status::Cancelled) << statusName(result.State) << ": " << result.Message;
+  EXPECT_FALSE(result.EnclosureVerified);
+}
+
+TEST(Cancel, BuildEnvelopeDirectly)
+{
+  const TriangleMesh input = makeSphere(Vec3(0, 0, 0), 1.0, 32, 16);
+  PollingCancel progress(0.0);
+  const EnvelopeResult env =
+    buildEnvelope(Normalization::fit(input).toUnit(input), EnvelopeOptions(), &progress);
+  EXPECT_EQ(env.State, Status::Cancelled) << statusName(env.State) << ": " << env.Message;
+  EXPECT_FALSE(env.EnclosureVerified);
+}
+
+TEST(Progress, ReportsStagesWithinZeroToOne)
+{
+  Recorder progress;
+  CageOptions options;
+  options.Envelope.IsoValue = 0.05; // a coarse, quick run
+  const CageResult result =
+    generateCage(PolygonMesh::fromTriangles(makeSphere(Vec3(0, 0, 0), 1.0, 32, 16)), options, &progress);
+  ASSERT_EQ(result.State, Status::Ok) << result.Message;
+  ASSERT_GE(progress.Fractions.size(), 2u);
+  for (const double f : progress.Fractions)
+  {
+    EXPECT_GE(f, 0.0);
+    EXPECT_LE(f, 1.0);
+  }
+  EXPECT_GE(progress.Stages.size(), 2u);
+  for (const std::string& s : progress.Stages)
+  {
+    EXPECT_FALSE(s.empty());
+  }
+  EXPECT_GT(*std::max_element(progress.Fractions.begin(), progress.Fractions.end()), 0.5);
+}
+
+// --- error paths -------------------------------------------------------------------------------
+
+TEST(CageErrors, EmptyInput)
+{
+  CageResult result = generateCage(PolygonMesh(), CageOptions());
+  EXPECT_EQ(result.State, Status::EmptyInput) << statusName(result.State);
+  EXPECT_TRUE(result.Cage.empty());
+
+  PolygonMesh lines;
+  lines.Points = { Vec3(0, 0, 0), Vec3(1, 0, 0) };
+  lines.addCell({ 0, 1 });
+  result = generateCage(lines, CageOptions());
+  EXPECT_EQ(result.State, Status::EmptyInput) << statusName(result.State);
+
+  const EnvelopeResult env = buildEnvelope(TriangleMesh(), EnvelopeOptions());
+  EXPECT_EQ(env.State, Status::EmptyInput) << statusName(env.State);
+}
+
+TEST(CageErrors, OpenInputNamesBoundaryEdges)
+{
+  TriangleMesh box = makeBox(Vec3(0, 0, 0), Vec3(1, 1, 1));
+  box.Triangles.resize(10); // a square hole: 4 boundary edges
+  const CageResult result = generateCage(PolygonMesh::fromTriangles(box), CageOptions());
+  EXPECT_EQ(result.State, Status::InvalidInput) << statusName(result.State);
+  EXPECT_EQ(result.Defects.BoundaryEdges, 4);
+  EXPECT_NE(result.Message.find("boundary edges"), std::string::npos) << result.Message;
+  EXPECT_NE(result.Message.find('4'), std::string::npos) << result.Message;
+  EXPECT_TRUE(result.Cage.empty());
+  EXPECT_FALSE(result.EnclosureVerified);
+}
+
+TEST(CageErrors, BrokenInputIsInvalid)
+{
+  PolygonMesh nan = PolygonMesh::fromTriangles(makeBox(Vec3(0, 0, 0), Vec3(1, 1, 1)));
+  nan.Points[2][0] = std::numeric_limits<double>::quiet_NaN();
+  CageResult result = generateCage(nan, CageOptions());
+  EXPECT_EQ(result.State, Status::InvalidInput) << statusName(result.State);
+  EXPECT_FALSE(result.Message.empty());
+
+  PolygonMesh badIds = PolygonMesh::fromTriangles(makeBox(Vec3(0, 0, 0), Vec3(1, 1, 1)));
+  badIds.addCell({ 0, 1, 1000 });
+  result = generateCage(badIds, CageOptions());
+  EXPECT_EQ(result.State, Status::InvalidInput) << statusName(result.State);
+  EXPECT_FALSE(result.Message.empty());
+}

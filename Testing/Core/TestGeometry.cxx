@@ -1,0 +1,378 @@
+// SDFCage — Testing: Normalization, distance primitives and the triangle index, against
+// brute force and against the independent CGAL checker.
+#include "ExactCheck.h"
+#include "Geometry.h"
+#include "Mesh.h"
+#include "Normalization.h"
+#include "Shapes.h"
+#include "TriangleIndex.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <random>
+#include <set>
+#include <vector>
+
+using namespace sdfcage;
+
+namespace
+{
+
+Vec3 randomPoint(std::mt19937& rng, double lo, double hi)
+{
+  std::uniform_real_distribution<double> u(lo, hi);
+  return Vec3(u(rng), u(rng), u(rng));
+}
+
+/// Points on a barycentric grid of n subdivisions on triangle (a, b, c).
+std::vector<Vec3> sampleTriangle(const Vec3& a, const Vec3& b, const Vec3& c, int n)
+{
+  std::vector<Vec3> s;
+  for (int i = 0; i <= n; ++i)
+  {
+    for (int j = 0; i + j <= n; ++j)
+    {
+      s.push_back(a + (double(i) / n) * (b - a) + (double(j) / n) * (c - a));
+    }
+  }
+  return s;
+}
+
+double longestEdge(const Vec3& a, const Vec3& b, const Vec3& c)
+{
+  return std::max({ (a - b).norm(), (b - c).norm(), (c - a).norm() });
+}
+
+/// Is q in triangle (a, b, c) up to eps (relative barycentric coordinates)?
+bool inTriangle(const Vec3& q, const Vec3& a, const Vec3& b, const Vec3& c, double eps)
+{
+  const Vec3 n = (b - a).cross(c - a);
+  const double area2 = n.squaredNorm();
+  if (std::abs((q - a).dot(n)) > eps * std::sqrt(area2) * longestEdge(a, b, c))
+  {
+    return false;
+  }
+  const double u = (c - b).cross(q - b).dot(n) / area2;
+  const double v = (a - c).cross(q - c).dot(n) / area2;
+  const double w = (b - a).cross(q - a).dot(n) / area2;
+  return u >= -eps && v >= -eps && w >= -eps;
+}
+
+} // namespace
+
+// --- Normalization --------------------------------------------------------------------------
+
+TEST(Normalization, FitsIntoTheUnitSphereAndRoundTrips)
+{
+  const TriangleMesh box = makeBox(Vec3(1, 2, -1), Vec3(3, 6, 1));
+  const Normalization n = Normalization::fit(box);
+  EXPECT_NEAR((n.Center - Vec3(2, 4, 0)).norm(), 0.0, 1e-15);
+  EXPECT_NEAR(n.Scale, 1.0 / std::sqrt(6.0), 1e-15);
+
+  const TriangleMesh unit = n.toUnit(box);
+  ASSERT_EQ(unit.Triangles, box.Triangles);
+  double largest = 0.0;
+  for (const Vec3& p : unit.Points)
+  {
+    largest = std::max(largest, p.norm());
+  }
+  EXPECT_NEAR(largest, 1.0, 1e-14);
+
+  const TriangleMesh back = n.toInput(unit);
+  for (std::size_t i = 0; i < box.Points.size(); ++i)
+  {
+    EXPECT_NEAR((back.Points[i] - box.Points[i]).norm(), 0.0, 1e-14);
+  }
+  std::mt19937 rng(7);
+  for (int i = 0; i < 100; ++i)
+  {
+    const Vec3 p = randomPoint(rng, -50, 50);
+    EXPECT_NEAR((n.toInput(n.toUnit(p)) - p).norm(), 0.0, 1e-12);
+    const double length = std::abs(p[0]);
+    EXPECT_NEAR(n.lengthToInput(n.lengthToUnit(length)), length, 1e-12);
+  }
+  // Lengths scale like distances between mapped points.
+  const Vec3 p(1, 1, 1), q(2, 3, 5);
+  EXPECT_NEAR((n.toUnit(p) - n.toUnit(q)).norm(), n.lengthToUnit((p - q).norm()), 1e-14);
+}
+
+// --- closest point, segment and triangle distances ---------------------------------------------
+
+TEST(Geometry, ClosestPointOnTriangleMatchesBruteForce)
+{
+  std::mt19937 rng(11);
+  const int n = 60;
+  for (int trial = 0; trial < 200; ++trial)
+  {
+    const Vec3 a = randomPoint(rng, -1, 1), b = randomPoint(rng, -1, 1), c = randomPoint(rng, -1, 1);
+    const Vec3 p = randomPoint(rng, -2, 2);
+    const Vec3 q = closestPointOnTriangle(p, a, b, c);
+    EXPECT_TRUE(inTriangle(q, a, b, c, 1e-9)) << "trial " << trial;
+    double best = std::numeric_limits<double>::infinity();
+    for (const Vec3& s : sampleTriangle(a, b, c, n))
+    {
+      best = std::min(best, (p - s).norm());
+    }
+    // q is at least as close as every sample, and no sample is farther than h from the optimum.
+    EXPECT_LE((p - q).norm(), best + 1e-12) << "trial " << trial;
+    EXPECT_GE((p - q).norm(), best - longestEdge(a, b, c) / n) << "trial " << trial;
+  }
+  // Vertex, edge and face regions of a right triangle, exactly.
+  const Vec3 a(0, 0, 0), b(1, 0, 0), c(0, 1, 0);
+  EXPECT_EQ(closestPointOnTriangle(Vec3(-1, -1, 3), a, b, c), a);
+  EXPECT_EQ(closestPointOnTriangle(Vec3(2, -1, 0), a, b, c), b);
+  EXPECT_NEAR((closestPointOnTriangle(Vec3(0.5, -2, 1), a, b, c) - Vec3(0.5, 0, 0)).norm(), 0, 1e-15);
+  EXPECT_NEAR((closestPointOnTriangle(Vec3(0.2, 0.3, -4), a, b, c) - Vec3(0.2, 0.3, 0)).norm(), 0, 1e-15);
+}
+
+TEST(Geometry, SegmentSegmentDistanceMatchesBruteForce)
+{
+  std::mt19937 rng(13);
+  const int n = 400;
+  for (int trial = 0; trial < 200; ++trial)
+  {
+    const Vec3 p0 = randomPoint(rng, -1, 1), p1 = randomPoint(rng, -1, 1);
+    const Vec3 q0 = randomPoint(rng, -1, 1), q1 = randomPoint(rng, -1, 1);
+    const double d = std::sqrt(segmentSegmentDistance2(p0, p1, q0, q1));
+    double best = std::numeric_limits<double>::infinity();
+    for (int i = 0; i <= n; ++i)
+    {
+      const Vec3 x = p0 + (double(i) / n) * (p1 - p0);
+      for (int j = 0; j <= n; ++j)
+      {
+        best = std::min(best, (x - (q0 + (double(j) / n) * (q1 - q0))).norm());
+      }
+    }
+    const double h = ((p1 - p0).norm() + (q1 - q0).norm()) / n;
+    EXPECT_LE(d, best + 1e-12) << "trial " << trial;
+    EXPECT_GE(d, best - h) << "trial " << trial;
+  }
+  // Parallel, collinear-overlapping, crossing and point-like segments.
+  EXPECT_NEAR(segmentSegmentDistance2(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0.5, 2, 0), Vec3(3, 2, 0)), 4.0, 1e-14);
+  EXPECT_NEAR(segmentSegmentDistance2(Vec3(0, 0, 0), Vec3(2, 0, 0), Vec3(1, 0, 0), Vec3(3, 0, 0)), 0.0, 1e-14);
+  EXPECT_NEAR(segmentSegmentDistance2(Vec3(-1, 0, 0), Vec3(1, 0, 0), Vec3(0, -1, 0), Vec3(0, 1, 0)), 0.0, 1e-14);
+  EXPECT_NEAR(segmentSegmentDistance2(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(3, 4, 0), Vec3(3, 4, 0)), 4.0 + 16.0, 1e-12);
+  EXPECT_NEAR(segmentSegmentDistance2(Vec3(1, 1, 1), Vec3(1, 1, 1), Vec3(1, 1, 4), Vec3(1, 1, 4)), 9.0, 1e-12);
+}
+
+TEST(Geometry, TriangleDistanceMatchesSamplingAndCgal)
+{
+  std::mt19937 rng(17);
+  const int n = 40;
+  for (int trial = 0; trial < 60; ++trial)
+  {
+    Vec3 a[3], b[3];
+    const Vec3 shift(0.6 + trial * 0.02, 0.0, 0.0); // from overlapping to well apart
+    for (int k = 0; k < 3; ++k)
+    {
+      a[k] = randomPoint(rng, -1, 1);
+      b[k] = randomPoint(rng, -1, 1) + shift;
+    }
+    const double d = std::sqrt(triangleTriangleDistance2(a, b));
+
+    // The CGAL checker on two one-triangle meshes measures the same distance independently.
+    TriangleMesh ta, tb;
+    ta.Points = { a[0], a[1], a[2] };
+    ta.Triangles = { { 0, 1, 2 } };
+    tb.Points = { b[0], b[1], b[2] };
+    tb.Triangles = { { 0, 1, 2 } };
+    const exact::ExactReport r = exact::exactCheck(ta, tb, 10.0);
+    EXPECT_NEAR(d, r.MinimumClearance, 1e-12) << "trial " << trial;
+    if (r.InputIntersections > 0)
+    {
+      EXPECT_EQ(d, 0.0) << "trial " << trial << ": the triangles intersect (exact predicate)";
+    }
+
+    double best = std::numeric_limits<double>::infinity();
+    const std::vector<Vec3> sa = sampleTriangle(a[0], a[1], a[2], n);
+    for (const Vec3& q : sampleTriangle(b[0], b[1], b[2], n))
+    {
+      for (const Vec3& p : sa)
+      {
+        best = std::min(best, (p - q).norm());
+      }
+    }
+    const double h = (longestEdge(a[0], a[1], a[2]) + longestEdge(b[0], b[1], b[2])) / n;
+    EXPECT_LE(d, best + 1e-12) << "trial " << trial;
+    EXPECT_GE(d, best - h) << "trial " << trial;
+  }
+}
+
+TEST(Geometry, WindingNumberInsideOutside)
+{
+  const TriangleMesh sphere = makeSphere(Vec3(0.5, -0.25, 2.0), 1.5, 32, 16);
+  std::mt19937 rng(19);
+  int inside = 0, outside = 0;
+  for (int i = 0; i < 300; ++i)
+  {
+    const Vec3 p = Vec3(0.5, -0.25, 2.0) + randomPoint(rng, -2.5, 2.5);
+    const double r = (p - Vec3(0.5, -0.25, 2.0)).norm();
+    if (std::abs(r - 1.5) < 0.05)
+    {
+      continue; // too close to the faceted surface to know the answer from the smooth sphere
+    }
+    const double w = windingNumber(sphere, p);
+    if (r < 1.5)
+    {
+      EXPECT_NEAR(w, 1.0, 0.01) << "at radius " << r;
+      ++inside;
+    }
+    else
+    {
+      EXPECT_NEAR(w, 0.0, 0.01) << "at radius " << r;
+      ++outside;
+    }
+  }
+  EXPECT_GT(inside, 10);
+  EXPECT_GT(outside, 10);
+
+  // A flipped mesh gives about -1 inside; a torus's hole is outside.
+  TriangleMesh flipped = sphere;
+  for (Triangle& t : flipped.Triangles)
+  {
+    std::swap(t[1], t[2]);
+  }
+  EXPECT_NEAR(windingNumber(flipped, Vec3(0.5, -0.25, 2.0)), -1.0, 0.01);
+  const TriangleMesh torus = makeTorus(Vec3(0, 0, 0), 1.0, 0.3, 48, 16);
+  EXPECT_NEAR(windingNumber(torus, Vec3(0, 0, 0)), 0.0, 0.01);
+  EXPECT_NEAR(windingNumber(torus, Vec3(1, 0, 0)), 1.0, 0.01);
+  EXPECT_NEAR(windingNumber(torus, Vec3(0, 0, 1)), 0.0, 0.01);
+}
+
+// --- TriangleIndex --------------------------------------------------------------------------
+
+namespace
+{
+
+TriangleMesh indexTestMesh()
+{
+  TriangleMesh m = makeSphere(Vec3(0, 0, 0), 1.0, 40, 20);
+  appendMesh(m, makeTorus(Vec3(2.5, 0, 0), 0.8, 0.2, 48, 12));
+  appendMesh(m, makeBox(Vec3(-3, -1, -1), Vec3(-2, 2, 0.5)));
+  return m;
+}
+
+/// Brute force: the distance from p to the mesh and the nearest triangle.
+double bruteDistance(const TriangleMesh& m, const Vec3& p, int& triangle)
+{
+  double best = std::numeric_limits<double>::infinity();
+  for (std::size_t t = 0; t < m.Triangles.size(); ++t)
+  {
+    const Triangle& tri = m.Triangles[t];
+    const double d = (p - closestPointOnTriangle(p, m.Points[tri[0]], m.Points[tri[1]],
+      m.Points[tri[2]])).norm();
+    if (d < best)
+    {
+      best = d;
+      triangle = static_cast<int>(t);
+    }
+  }
+  return best;
+}
+
+} // namespace
+
+TEST(TriangleIndex, ClosestPointMatchesBruteForce)
+{
+  const TriangleMesh mesh = indexTestMesh();
+  for (const double cellSize : { 0.0, 0.05, 0.7 })
+  {
+    TriangleIndex index;
+    index.build(mesh, cellSize);
+    std::mt19937 rng(23);
+    for (int i = 0; i < 300; ++i)
+    {
+      // Mostly near the surfaces, some far outside the grid.
+      const Vec3 p = i % 10 == 0 ? randomPoint(rng, -12, 12) : randomPoint(rng, -3.5, 3.5);
+      int bruteTriangle = -1;
+      const double expected = bruteDistance(mesh, p, bruteTriangle);
+      Vec3 closest;
+      int triangle = -1;
+      double distance = -1;
+      ASSERT_TRUE(index.closestPoint(p, -1.0, closest, triangle, distance)) << "cell " << cellSize;
+      EXPECT_NEAR(distance, expected, 1e-12) << "cell " << cellSize << " point " << i;
+      EXPECT_NEAR((p - closest).norm(), distance, 1e-12);
+      ASSERT_GE(triangle, 0);
+      ASSERT_LT(triangle, static_cast<int>(mesh.Triangles.size()));
+      const Triangle& tri = mesh.Triangles[triangle];
+      EXPECT_TRUE(inTriangle(closest, mesh.Points[tri[0]], mesh.Points[tri[1]], mesh.Points[tri[2]], 1e-9));
+      EXPECT_NEAR(index.distance(p), expected, 1e-12);
+
+      // A search radius below the distance finds nothing; above it finds the same point.
+      Vec3 c2;
+      int t2;
+      double d2;
+      if (expected > 1e-3)
+      {
+        EXPECT_FALSE(index.closestPoint(p, 0.5 * expected, c2, t2, d2));
+      }
+      ASSERT_TRUE(index.closestPoint(p, 1.01 * expected + 1e-9, c2, t2, d2));
+      EXPECT_NEAR(d2, expected, 1e-12);
+    }
+  }
+}
+
+TEST(TriangleIndex, BoxQueryReportsEachOverlappingTriangleOnce)
+{
+  const TriangleMesh mesh = indexTestMesh();
+  TriangleIndex index;
+  index.build(mesh, 0.1);
+  std::mt19937 rng(29);
+  for (int q = 0; q < 50; ++q)
+  {
+    const Vec3 c = randomPoint(rng, -3.5, 3.5);
+    const Vec3 half = randomPoint(rng, 0.0, 0.6);
+    const Vec3 lo = c - half, hi = c + half;
+    std::multiset<int> reported;
+    index.forEachTriangleInBox(lo, hi, [&](int t) { reported.insert(t); });
+    std::set<int> expected;
+    for (std::size_t t = 0; t < mesh.Triangles.size(); ++t)
+    {
+      const Triangle& tri = mesh.Triangles[t];
+      const Vec3 tlo = mesh.Points[tri[0]].cwiseMin(mesh.Points[tri[1]]).cwiseMin(mesh.Points[tri[2]]);
+      const Vec3 thi = mesh.Points[tri[0]].cwiseMax(mesh.Points[tri[1]]).cwiseMax(mesh.Points[tri[2]]);
+      if (!((tlo.array() > hi.array()).any() || (thi.array() < lo.array()).any()))
+      {
+        expected.insert(static_cast<int>(t));
+      }
+    }
+    EXPECT_EQ(std::set<int>(reported.begin(), reported.end()), expected) << "query " << q;
+    EXPECT_EQ(reported.size(), expected.size()) << "query " << q << ": a triangle was repeated";
+  }
+}
+
+TEST(TriangleIndex, TriangleDistanceMatchesBruteForce)
+{
+  const TriangleMesh mesh = indexTestMesh();
+  TriangleIndex index;
+  index.build(mesh);
+  std::mt19937 rng(31);
+  for (int q = 0; q < 60; ++q)
+  {
+    Vec3 t[3];
+    const Vec3 c = randomPoint(rng, -3.5, 3.5);
+    for (int k = 0; k < 3; ++k)
+    {
+      t[k] = c + randomPoint(rng, -0.2, 0.2);
+    }
+    double expected = std::numeric_limits<double>::infinity();
+    for (const Triangle& tri : mesh.Triangles)
+    {
+      const Vec3 m[3] = { mesh.Points[tri[0]], mesh.Points[tri[1]], mesh.Points[tri[2]] };
+      expected = std::min(expected, std::sqrt(triangleTriangleDistance2(t, m)));
+    }
+    const double limit = 0.5;
+    const double d = index.triangleDistance(t, limit);
+    if (expected < limit)
+    {
+      EXPECT_NEAR(d, expected, 1e-12) << "query " << q;
+    }
+    else
+    {
+      EXPECT_EQ(d, limit) << "query " << q;
+    }
+  }
+}
