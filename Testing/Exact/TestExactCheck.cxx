@@ -2,6 +2,10 @@
 #include "ExactCheck.h"
 #include "MeshIO.h"
 
+#include <CGAL/Exact_predicates_inexact_constructions_kernel.h>
+#include <CGAL/Polygon_mesh_processing/self_intersections.h>
+#include <CGAL/Surface_mesh.h>
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -330,6 +334,47 @@ TEST(ExactCheck, EdgeSharingTriangles)
   EXPECT_EQ(exactCheck(TriangleMesh(), m, 1.0).SelfIntersections, 0);
   m.Triangles.push_back({ 2, 1, 0 }); // a duplicated triangle
   EXPECT_GE(exactCheck(TriangleMesh(), m, 1.0).SelfIntersections, 1);
+}
+
+TEST(ExactCheck, SelfIntersectionsAgreeWithCgalPmp)
+{
+  // A torus with folds (some vertices pushed far through the surface) and a second, crossing
+  // torus: hundreds of intersecting pairs, adjacent and not. CGAL's
+  // Polygon_mesh_processing::self_intersections must count the same pairs.
+  TriangleMesh mesh = torus(2.0, 0.6, 40, 16);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (std::size_t v = 0; v < mesh.Points.size(); v += 7)
+  {
+    mesh.Points[v] += 0.5 * Vec3(u(rng), u(rng), u(rng));
+  }
+  TriangleMesh crossing = torus(1.0, 0.4, 24, 12);
+  for (Vec3& p : crossing.Points)
+  {
+    p = Vec3(p[0] + 2.0, p[2], p[1]); // in the xz plane, through the first torus's tube
+  }
+  append(mesh, crossing);
+
+  using K = CGAL::Exact_predicates_inexact_constructions_kernel;
+  using Mesh = CGAL::Surface_mesh<K::Point_3>;
+  Mesh sm;
+  std::vector<Mesh::Vertex_index> vertices;
+  for (const Vec3& p : mesh.Points)
+  {
+    vertices.push_back(sm.add_vertex(K::Point_3(p[0], p[1], p[2])));
+  }
+  for (const Triangle& t : mesh.Triangles)
+  {
+    ASSERT_NE(sm.add_face(vertices[t[0]], vertices[t[1]], vertices[t[2]]), Mesh::null_face());
+  }
+  std::vector<std::pair<Mesh::Face_index, Mesh::Face_index>> pairs;
+  CGAL::Polygon_mesh_processing::self_intersections(sm, std::back_inserter(pairs));
+
+  const ExactReport r = exactCheck(TriangleMesh(), mesh, 1.0);
+  EXPECT_GT(pairs.size(), 100u);
+  EXPECT_EQ(r.SelfIntersections, static_cast<long long>(pairs.size()));
+  EXPECT_EQ(r.CageComponents, 2);
+  EXPECT_TRUE(r.Closed2Manifold);
 }
 
 TEST(ExactCheck, DegenerateAndInvalidTrianglesDoNotCrash)
