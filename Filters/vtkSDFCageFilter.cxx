@@ -274,7 +274,9 @@ void AddFieldValue(vtkFieldData* fd, const char* name, ValueT value)
 vtkSDFCageFilter::vtkSDFCageFilter()
 {
   // The defaults are Core's, so that the filter, the CLI and the plugin agree.
-  const sdfcage::EnvelopeOptions defaults;
+  const sdfcage::CageOptions cageDefaults;
+  const sdfcage::EnvelopeOptions& defaults = cageDefaults.Envelope;
+  this->NumberOfVertices = cageDefaults.TargetNumberOfVertices;
   this->IsoValue = defaults.IsoValue;
   this->VoxelSize = defaults.VoxelSize;
   this->MinimumClearance = defaults.MinimumClearance;
@@ -298,12 +300,18 @@ void vtkSDFCageFilter::ResetResults()
   this->DistanceFieldTime = 0.0;
   this->IsosurfaceTime = 0.0;
   this->VerificationTime = 0.0;
+  this->SimplificationTime = 0.0;
+  this->CageVerificationTime = 0.0;
   this->TotalTime = 0.0;
+  this->VerticesReached = 0;
+  this->TargetReached = false;
+  this->StopReason.clear();
   this->MeasuredClearance = 0.0;
   this->MeasuredClearanceRelative = 0.0;
   this->EnclosureVerified = false;
   this->RemovedPockets = 0;
   this->EnvelopeGenus = 0;
+  this->EnvelopeComponents = 0;
   this->VoxelSizeUsed = 0.0;
   this->InputWasFlipped = false;
   this->StatusString = "NotExecuted";
@@ -348,13 +356,19 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
     AddFieldValue<vtkDoubleArray>(fd, "DistanceFieldTime", this->DistanceFieldTime);
     AddFieldValue<vtkDoubleArray>(fd, "IsosurfaceTime", this->IsosurfaceTime);
     AddFieldValue<vtkDoubleArray>(fd, "VerificationTime", this->VerificationTime);
+    AddFieldValue<vtkDoubleArray>(fd, "SimplificationTime", this->SimplificationTime);
+    AddFieldValue<vtkDoubleArray>(fd, "CageVerificationTime", this->CageVerificationTime);
     AddFieldValue<vtkDoubleArray>(fd, "TotalTime", this->TotalTime);
+    AddFieldValue<vtkIntArray>(fd, "VerticesReached", this->VerticesReached);
+    AddFieldValue<vtkIntArray>(fd, "TargetReached", this->TargetReached ? 1 : 0);
+    AddFieldValue<vtkStringArray>(fd, "StopReason", this->StopReason);
     AddFieldValue<vtkDoubleArray>(fd, "MeasuredClearance", this->MeasuredClearance);
     AddFieldValue<vtkDoubleArray>(
       fd, "MeasuredClearanceRelative", this->MeasuredClearanceRelative);
     AddFieldValue<vtkIntArray>(fd, "EnclosureVerified", this->EnclosureVerified ? 1 : 0);
     AddFieldValue<vtkIntArray>(fd, "RemovedPockets", this->RemovedPockets);
     AddFieldValue<vtkIntArray>(fd, "EnvelopeGenus", this->EnvelopeGenus);
+    AddFieldValue<vtkIntArray>(fd, "EnvelopeComponents", this->EnvelopeComponents);
     AddFieldValue<vtkDoubleArray>(fd, "VoxelSizeUsed", this->VoxelSizeUsed);
     AddFieldValue<vtkIntArray>(fd, "InputWasFlipped", this->InputWasFlipped ? 1 : 0);
     AddFieldValue<vtkStringArray>(fd, "Status", this->StatusString);
@@ -391,6 +405,7 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
     ToPolygonMesh(input, mesh);
 
     sdfcage::CageOptions options;
+    options.TargetNumberOfVertices = this->NumberOfVertices;
     options.Envelope.IsoValue = this->IsoValue;
     options.Envelope.VoxelSize = this->VoxelSize;
     options.Envelope.MinimumClearance = this->MinimumClearance;
@@ -407,12 +422,18 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
     this->DistanceFieldTime = result.DistanceFieldSeconds;
     this->IsosurfaceTime = result.IsosurfaceSeconds;
     this->VerificationTime = result.VerificationSeconds;
+    this->SimplificationTime = result.SimplificationSeconds;
+    this->CageVerificationTime = result.CageVerificationSeconds;
     this->TotalTime = result.TotalSeconds;
+    this->VerticesReached = result.VerticesReached;
+    this->TargetReached = result.TargetReached;
+    this->StopReason = result.StopReason;
     this->MeasuredClearance = result.MinimumClearance;
     this->MeasuredClearanceRelative = result.MinimumClearanceRelative;
     this->EnclosureVerified = result.EnclosureVerified;
     this->RemovedPockets = result.RemovedPockets;
     this->EnvelopeGenus = result.EnvelopeGenus;
+    this->EnvelopeComponents = result.EnvelopeComponents;
     this->VoxelSizeUsed = result.VoxelSizeUsed;
     this->InputWasFlipped = result.Defects.FlippedOrientation;
     this->StatusString = StatusIdentifier(result.State);
@@ -427,8 +448,14 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
         publish();
         return 1;
       case sdfcage::Status::Cancelled:
-        // Aborted by the user: empty outputs, no error.
+        // Aborted by the user, no error. A cancel during the simplification leaves a verified,
+        // valid cage (with more vertices than asked): output it; before that there is none.
         vtkDebugMacro("Execution cancelled: " << result.Message);
+        if (!result.Cage.empty())
+        {
+          ToPolyData(result.Cage, result.CageDistanceToInput, cageOutput);
+          ToPolyData(result.Envelope, result.EnvelopeDistanceToInput, envelopeOutput);
+        }
         publish();
         return 1;
       case sdfcage::Status::InvalidInput:
@@ -453,7 +480,14 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
             (result.Message.empty() ? std::string("no reason given") : result.Message));
     }
 
-    const std::vector<std::string> warnings = result.Defects.warnings();
+    std::vector<std::string> warnings = result.Defects.warnings();
+    if (!result.TargetReached)
+    {
+      std::ostringstream msg;
+      msg << "the cage has " << result.VerticesReached << " vertices, not the " << this->NumberOfVertices
+          << " asked for: " << (result.StopReason.empty() ? "no reason given" : result.StopReason);
+      warnings.push_back(msg.str());
+    }
     if (!warnings.empty())
     {
       std::ostringstream msg;
@@ -502,6 +536,7 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
 void vtkSDFCageFilter::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
+  os << indent << "NumberOfVertices: " << this->NumberOfVertices << "\n";
   os << indent << "IsoValue: " << this->IsoValue << "\n";
   os << indent << "VoxelSize: " << this->VoxelSize << "\n";
   os << indent << "MinimumClearance: " << this->MinimumClearance << "\n";
@@ -516,12 +551,18 @@ void vtkSDFCageFilter::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "DistanceFieldTime: " << this->DistanceFieldTime << "\n";
   os << indent << "IsosurfaceTime: " << this->IsosurfaceTime << "\n";
   os << indent << "VerificationTime: " << this->VerificationTime << "\n";
+  os << indent << "SimplificationTime: " << this->SimplificationTime << "\n";
+  os << indent << "CageVerificationTime: " << this->CageVerificationTime << "\n";
   os << indent << "TotalTime: " << this->TotalTime << "\n";
+  os << indent << "VerticesReached: " << this->VerticesReached << "\n";
+  os << indent << "TargetReached: " << this->TargetReached << "\n";
+  os << indent << "StopReason: " << this->StopReason << "\n";
   os << indent << "MeasuredClearance: " << this->MeasuredClearance << "\n";
   os << indent << "MeasuredClearanceRelative: " << this->MeasuredClearanceRelative << "\n";
   os << indent << "EnclosureVerified: " << this->EnclosureVerified << "\n";
   os << indent << "RemovedPockets: " << this->RemovedPockets << "\n";
   os << indent << "EnvelopeGenus: " << this->EnvelopeGenus << "\n";
+  os << indent << "EnvelopeComponents: " << this->EnvelopeComponents << "\n";
   os << indent << "VoxelSizeUsed: " << this->VoxelSizeUsed << "\n";
   os << indent << "InputWasFlipped: " << this->InputWasFlipped << "\n";
 }

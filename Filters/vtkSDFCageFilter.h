@@ -10,24 +10,26 @@
  * @class   vtkSDFCageFilter
  * @brief   build a cage (a coarse closed mesh strictly enclosing the input) from an SDF envelope
  *
- * vtkSDFCageFilter implements the envelope stage of "High-quality Cage Generation Based on SDF"
- * (the paper in reference/sdf-cage-paper.md, §3.1): the input surface is scaled into the unit
- * sphere, its signed distance field is sampled on a grid of size VoxelSize, and the isosurface
- * {SDF = IsoValue} is extracted. Trapped air pockets (inner components) are removed and the
- * result is verified: it must be a closed 2-manifold that keeps at least MinimumClearance from
- * every input triangle (exact triangle-triangle distances) and contain every input component.
- * If the check fails, the grid is refined and the envelope rebuilt.
+ * vtkSDFCageFilter implements "High-quality Cage Generation Based on SDF" (the paper in
+ * reference/sdf-cage-paper.md). Envelope stage (§3.1): the input surface is scaled into the
+ * unit sphere, its signed distance field is sampled on a grid of size VoxelSize, and the
+ * isosurface {SDF = IsoValue} is extracted. Trapped air pockets (inner components) are removed
+ * and the result is verified: it must be a closed 2-manifold that keeps at least
+ * MinimumClearance from every input triangle (exact triangle-triangle distances) and contain
+ * every input component; if the check fails, the grid is refined and the envelope rebuilt.
+ * Simplification stage (§3.2): constrained quadric-error edge collapses reduce the envelope to
+ * NumberOfVertices vertices; every collapse keeps the clearance, avoids self-intersections and
+ * keeps the surface manifold, and the final cage is verified again independently.
  *
  * The input must be a closed (watertight), manifold, consistently oriented surface: polygons and
  * triangle strips are triangulated, vertex and line cells are ignored, an inward-oriented mesh is
  * flipped (with a warning). Several components are allowed.
  *
  * Outputs:
- * - port 0 ("Cage"): the cage. For now the cage *is* the verified envelope; the constrained
- *   simplification of §3.2 will reduce it to a requested number of vertices. Point array
- *   `DistanceToInput` (double, input units) and field data with the results listed below
- *   (one-tuple arrays named like the getters, plus the string array `Status`).
- * - port 1 ("Envelope"): the verified envelope, with point array `DistanceToInput`.
+ * - port 0 ("Cage"): the cage, with point array `DistanceToInput` (double, input units) and
+ *   field data holding the results listed below (one-tuple arrays named like the getters, plus
+ *   the string arrays `Status`, `LastErrorMessage` and `StopReason`).
+ * - port 1 ("Envelope"): the verified dense envelope, with point array `DistanceToInput`.
  * - port 2 ("Distance Field"): a vtkImageData with the sampled signed distance as point array
  *   `SignedDistance` (input units; negative inside, positive outside) when GenerateDistanceField
  *   is on, an empty image otherwise. The field is exact only in a narrow band around the input
@@ -39,21 +41,25 @@
  *
  * The work is done by SDFCage::Core (sdfcage::generateCage) with TBB/OpenVDB threads; results do
  * not depend on the number of threads. Progress is reported from the thread that called
- * Update() only, and GetAbortExecute() cancels the run at the next checkpoint: the outputs are
- * then empty, GetStatusString() is "Cancelled", and no error is reported. VTK 9.1 clears the
- * abort flag when the next execution starts; the VTK bundled with ParaView 5.11 keeps it set
- * until SetAbortExecute(0) (the filter then keeps producing empty outputs).
+ * Update() only. GetAbortExecute() cancels the run at the next checkpoint, without an error and
+ * with GetStatusString() "Cancelled": before the simplification the outputs are empty; during
+ * it, the cage simplified so far (verified, valid, with more vertices than asked) and the
+ * envelope are output. VTK 9.1 clears the abort flag when the next execution starts; the VTK
+ * bundled with ParaView 5.11 keeps it set until SetAbortExecute(0).
  *
  * @warning The input must be closed: an open, non-manifold or degenerate input is rejected with
  * an error that names the defect and its count (e.g. "the mesh has 12 boundary edges ...") and
- * all outputs are empty. If the envelope cannot be verified even after refinement, that is an
- * error too: the cage output stays empty and the unverified envelope is put on port 1 (with its
- * `DistanceToInput`) so the failure can be inspected. Self-intersecting inputs are not detected. Empty input is not an error:
- * the outputs are empty. The memory of the sampled grid grows as 1/VoxelSize^2 (narrow band);
- * GenerateDistanceField stores a dense grid (1/VoxelSize^3 values).
+ * all outputs are empty. Self-intersecting inputs are not detected. If the envelope or the cage
+ * cannot be verified, that is an error too: the cage output stays empty and the envelope (if
+ * any) is put on port 1 so the failure can be inspected. If the simplification cannot reach
+ * NumberOfVertices (no feasible collapse left), the cage it reached is output with a warning
+ * that gives the reason (GetTargetReached() is false). Empty input is not an error: the outputs
+ * are empty. The sampled grid's memory grows as 1/VoxelSize^2 (narrow band); GenerateDistanceField
+ * stores a dense grid (1/VoxelSize^3 values).
  *
  * @sa
- * vtkFillHolesFilter vtkTriangleFilter vtkCleanPolyData vtkOFFReader vtkOFFWriter
+ * vtkFillHolesFilter vtkTriangleFilter vtkCleanPolyData vtkQuadricDecimation vtkOFFReader
+ * vtkOFFWriter
  */
 
 #ifndef vtkSDFCageFilter_h
@@ -70,6 +76,15 @@ public:
   vtkTypeMacro(vtkSDFCageFilter, vtkPolyDataAlgorithm);
   void PrintSelf(ostream& os, vtkIndent indent) override;
   static vtkSDFCageFilter* New();
+
+  ///@{
+  /**
+   * Number of vertices of the cage (the simplification stops there). 0 skips the
+   * simplification: the cage is then the dense verified envelope. Default 500 (Core's).
+   */
+  vtkSetClampMacro(NumberOfVertices, int, 0, VTK_INT_MAX);
+  vtkGetMacro(NumberOfVertices, int);
+  ///@}
 
   ///@{
   /**
@@ -139,13 +154,28 @@ public:
 
   ///@{
   /**
-   * Timings of the last execution, in seconds (only valid after the filter has executed).
+   * Timings of the last execution, in seconds (only valid after the filter has executed):
+   * input validation, distance field, isosurface, envelope verification, simplification, final
+   * cage verification, and the whole run.
    */
   vtkGetMacro(ValidationTime, double);
   vtkGetMacro(DistanceFieldTime, double);
   vtkGetMacro(IsosurfaceTime, double);
   vtkGetMacro(VerificationTime, double);
+  vtkGetMacro(SimplificationTime, double);
+  vtkGetMacro(CageVerificationTime, double);
   vtkGetMacro(TotalTime, double);
+  ///@}
+
+  ///@{
+  /**
+   * Simplification outcome (only valid after the filter has executed): the number of cage
+   * vertices reached, whether it equals NumberOfVertices, and why the simplification stopped
+   * early (empty when the target was reached).
+   */
+  vtkGetMacro(VerticesReached, int);
+  vtkGetMacro(TargetReached, bool);
+  const char* GetStopReason() const { return this->StopReason.c_str(); }
   ///@}
 
   ///@{
@@ -161,13 +191,14 @@ public:
   ///@{
   /**
    * Verdicts and counts of the last execution (only valid after the filter has executed):
-   * whether enclosure was verified, how many trapped air pockets were removed, the genus of the
-   * envelope, the voxel size actually used (relative, after refinements), and whether the input
-   * was inward-oriented and had to be flipped.
+   * whether enclosure was verified, how many trapped air pockets were removed, the genus and the
+   * number of components of the envelope, the voxel size actually used (relative, after
+   * refinements), and whether the input was inward-oriented and had to be flipped.
    */
   vtkGetMacro(EnclosureVerified, bool);
   vtkGetMacro(RemovedPockets, int);
   vtkGetMacro(EnvelopeGenus, int);
+  vtkGetMacro(EnvelopeComponents, int);
   vtkGetMacro(VoxelSizeUsed, double);
   vtkGetMacro(InputWasFlipped, bool);
   ///@}
@@ -191,6 +222,7 @@ protected:
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
   // parameters
+  int NumberOfVertices;
   double IsoValue;
   double VoxelSize;
   double MinimumClearance;
@@ -204,12 +236,18 @@ protected:
   double DistanceFieldTime = 0.0;
   double IsosurfaceTime = 0.0;
   double VerificationTime = 0.0;
+  double SimplificationTime = 0.0;
+  double CageVerificationTime = 0.0;
   double TotalTime = 0.0;
+  int VerticesReached = 0;
+  bool TargetReached = false;
+  std::string StopReason;
   double MeasuredClearance = 0.0;
   double MeasuredClearanceRelative = 0.0;
   bool EnclosureVerified = false;
   int RemovedPockets = 0;
   int EnvelopeGenus = 0;
+  int EnvelopeComponents = 0;
   double VoxelSizeUsed = 0.0;
   bool InputWasFlipped = false;
   std::string StatusString;
