@@ -22,7 +22,7 @@
 #include "vtkStringArray.h"
 #include "vtkTriangleFilter.h"
 
-#include "Envelope.h" // Core: the default options the filter must mirror
+#include "CageGenerator.h" // Core: the default options the filter must mirror
 #include "Shapes.h"   // Core: the built-in test shape
 
 #include <chrono>
@@ -143,10 +143,27 @@ void CheckSuccessfulRun(Checker& c, vtkSDFCageFilter* filter, vtkPolyData* input
     {
       double range[2];
       distance->GetRange(range);
-      c.Check(range[0] >= filter->GetMeasuredClearance() * (1 - 1e-9),
-        name + " min DistanceToInput " + Str(range[0]) + " >= MeasuredClearance " +
-          Str(filter->GetMeasuredClearance()));
+      // MeasuredClearance is the cage's; the envelope only promises delta (in input units:
+      // delta x MeasuredClearance / MeasuredClearanceRelative).
+      const double bound = port == 0 ? filter->GetMeasuredClearance()
+                                     : delta * filter->GetMeasuredClearance() /
+          filter->GetMeasuredClearanceRelative();
+      c.Check(range[0] >= bound * (1 - 1e-9),
+        name + " min DistanceToInput " + Str(range[0]) + " >= " + Str(bound));
     }
+  }
+  vtkPolyData* cageOut = filter->GetOutput(0);
+  c.Check(filter->GetVerticesReached() == cageOut->GetNumberOfPoints(),
+    "VerticesReached = cage points (" + Str(filter->GetVerticesReached()) + ")");
+  if (filter->GetNumberOfVertices() > 0)
+  {
+    c.Check(filter->GetTargetReached() ==
+        (cageOut->GetNumberOfPoints() == filter->GetNumberOfVertices()),
+      "TargetReached agrees with the cage's vertex count");
+    c.Check(cageOut->GetNumberOfPoints() >= filter->GetNumberOfVertices(),
+      "the cage has at least NumberOfVertices vertices");
+    c.Check(filter->GetTargetReached() == std::string(filter->GetStopReason()).empty(),
+      "a StopReason is given exactly when the target was missed");
   }
 
   vtkPolyData* cage = filter->GetOutput(0);
@@ -157,8 +174,9 @@ void CheckSuccessfulRun(Checker& c, vtkSDFCageFilter* filter, vtkPolyData* input
   c.Check(FieldNumber(cage, "EnvelopeGenus") == filter->GetEnvelopeGenus(),
     "field data EnvelopeGenus equals the getter");
   for (const char* name : { "ValidationTime", "DistanceFieldTime", "IsosurfaceTime",
-         "VerificationTime", "TotalTime", "MeasuredClearanceRelative", "RemovedPockets",
-         "VoxelSizeUsed", "InputWasFlipped" })
+         "VerificationTime", "SimplificationTime", "CageVerificationTime", "TotalTime",
+         "VerticesReached", "TargetReached", "MeasuredClearanceRelative", "RemovedPockets",
+         "EnvelopeComponents", "VoxelSizeUsed", "InputWasFlipped" })
   {
     c.Check(!std::isnan(FieldNumber(cage, name)), std::string("field data has ") + name);
   }
@@ -172,11 +190,15 @@ void PrintResults(vtkSDFCageFilter* filter)
 {
   vtkPolyData* cage = filter->GetOutput(0);
   std::cout << "  status " << filter->GetStatusString() << ", cage " << cage->GetNumberOfPoints()
-            << " points / " << cage->GetNumberOfPolys() << " triangles, genus "
+            << " points / " << cage->GetNumberOfPolys() << " triangles (target "
+            << filter->GetNumberOfVertices() << (filter->GetTargetReached() ? " reached" : " missed: ")
+            << filter->GetStopReason() << "), envelope "
+            << filter->GetOutput(1)->GetNumberOfPoints() << " points, genus "
             << filter->GetEnvelopeGenus() << ", pockets removed " << filter->GetRemovedPockets()
             << ", clearance " << filter->GetMeasuredClearance() << " (relative "
             << filter->GetMeasuredClearanceRelative() << "), voxel "
-            << filter->GetVoxelSizeUsed() << ", time " << filter->GetTotalTime() << " s\n";
+            << filter->GetVoxelSizeUsed() << ", time " << filter->GetTotalTime() << " s (simplify "
+            << filter->GetSimplificationTime() << " s)\n";
 }
 
 } // namespace
@@ -226,8 +248,13 @@ int TestSphere(const Context&)
     // facets deviate from the true sphere by < 1% of R at this resolution
     c.Check(worst < 0.01 * radius,
       "DistanceToInput matches |p - center| - R within facet error, worst " + Str(worst));
+  }
+  auto* envelopeDistance = vtkDoubleArray::SafeDownCast(
+    filter->GetOutput(1)->GetPointData()->GetArray("DistanceToInput"));
+  if (envelopeDistance)
+  {
     double range[2];
-    distance->GetRange(range);
+    envelopeDistance->GetRange(range);
     c.Check(range[1] < 0.05 * radius, "the envelope hugs the sphere (max distance " +
         Str(range[1]) + " < 5% of R)");
   }
@@ -437,7 +464,7 @@ int TestAbort(const Context&)
     c.Check(progress->Events < 1000, "progress events are throttled (" + Str(progress->Events) + ")");
   }
 
-  for (double threshold : { 0.0, 0.3 })
+  for (double threshold : { 0.0, 0.3, 0.6 })
   {
     vtkNew<vtkSDFCageFilter> filter;
     vtkNew<MessageRecorder> messages;
@@ -462,15 +489,19 @@ int TestAbort(const Context&)
     const std::string status = filter->GetStatusString();
     c.Check(status == "Cancelled" || status == "Ok", tag + "status Cancelled (or Ok)");
     vtkPolyData* cage = filter->GetOutput(0);
-    if (status == "Cancelled")
+    if (IsEmpty(cage))
     {
-      c.Check(IsEmpty(cage), tag + "empty cage after cancel");
-      c.Check(IsEmpty(filter->GetOutput(1)), tag + "empty envelope after cancel");
+      c.Check(status == "Cancelled", tag + "an empty cage only when cancelled");
+      c.Check(IsEmpty(filter->GetOutput(1)), tag + "empty envelope with the empty cage");
     }
     else
     {
-      c.Check(cage->GetNumberOfPoints() > 0 && CountOpenEdges(cage) == 0,
-        tag + "a finished run is valid");
+      // finished anyway, or cancelled during the simplification: a valid, verified cage
+      std::cout << "  " << tag << "cage of " << cage->GetNumberOfPoints() << " points\n";
+      c.Check(CountOpenEdges(cage) == 0, tag + "the cage output is closed");
+      c.Check(filter->GetEnclosureVerified(), tag + "the cage output is verified");
+      c.Check(cage->GetNumberOfPoints() >= filter->GetNumberOfVertices(),
+        tag + "no fewer vertices than asked");
     }
     // "Promptly": well before a full run would have finished.
     c.Check(afterAbort < 0.5 * fullSeconds + 0.25,
@@ -579,6 +610,8 @@ int TestParameters(const Context&)
     "GenerateDistanceField default = Core's");
   c.Check(filter->GetNumberOfThreads() == core.NumberOfThreads, "NumberOfThreads default = Core's");
   c.Check(filter->GetIsoValue() == 0.01, "IsoValue default is the paper's 0.01");
+  c.Check(filter->GetNumberOfVertices() == sdfcage::CageOptions().TargetNumberOfVertices,
+    "NumberOfVertices default = Core's");
 
   filter->SetIsoValue(-1.0);
   c.Check(filter->GetIsoValue() > 0, "IsoValue is clamped to a positive value");
@@ -631,6 +664,19 @@ int TestParameters(const Context&)
     same = p[0] == q[0] && p[1] == q[1] && p[2] == q[2];
   }
   c.Check(same, "identical cages with 1 thread and all threads");
+
+  // NumberOfVertices: an explicit target is met exactly; 0 makes the cage the envelope.
+  explicitFilter->SetNumberOfVertices(120);
+  explicitFilter->Update();
+  PrintResults(explicitFilter);
+  CheckSuccessfulRun(c, explicitFilter, input);
+  c.Check(explicitFilter->GetOutput(0)->GetNumberOfPoints() == 120, "a 120-vertex cage");
+  explicitFilter->SetNumberOfVertices(0);
+  explicitFilter->Update();
+  CheckSuccessfulRun(c, explicitFilter, input);
+  c.Check(explicitFilter->GetOutput(0)->GetNumberOfPoints() ==
+      explicitFilter->GetOutput(1)->GetNumberOfPoints(),
+    "NumberOfVertices 0: the cage is the envelope");
   return c.Result();
 }
 
