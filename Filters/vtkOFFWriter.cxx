@@ -17,7 +17,7 @@
 #include "vtksys/FStream.hxx"
 
 #include <cstdio>
-#include <limits>
+#include <utility>
 
 vtkStandardNewMacro(vtkOFFWriter);
 

@@ -28,10 +28,12 @@
 #include "CageGenerator.h"
 #include "Progress.h"
 
+#include <algorithm>
 #include <exception>
 #include <new>
 #include <sstream>
 #include <thread>
+#include <utility>
 
 vtkStandardNewMacro(vtkSDFCageFilter);
 

@@ -10,6 +10,8 @@
 #include "vtkPolyData.h"
 #include "vtkSphereSource.h"
 
+#include <algorithm>
+#include <cmath>
 #include <fstream>
 
 namespace sdfcage_test

@@ -25,6 +25,7 @@
 #include "CageGenerator.h" // Core: the default options the filter must mirror
 #include "Shapes.h"   // Core: the built-in test shape
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fstream>
