@@ -89,6 +89,11 @@ exact::ExactReport expectEncloses(const TriangleMesh& input, const TriangleMesh&
   return r;
 }
 
+void PrintTo(const ShapeCase& shape, std::ostream* os)
+{
+  *os << shape.Name;
+}
+
 class EnvelopeShapes : public ::testing::TestWithParam<ShapeCase>
 {
 };
@@ -110,42 +115,110 @@ TEST_P(EnvelopeShapes, GenerateCageEnclosesExactly)
   EXPECT_TRUE(result.Message.empty()) << result.Message;
   EXPECT_TRUE(result.Defects.usable());
   ASSERT_TRUE(result.EnclosureVerified);
+  ASSERT_FALSE(result.Envelope.empty());
   ASSERT_FALSE(result.Cage.empty());
   std::cout << "[ timing   ] " << shape.Name << ": total " << result.TotalSeconds << " s (SDF "
             << result.DistanceFieldSeconds << ", isosurface " << result.IsosurfaceSeconds
-            << ", verification " << result.VerificationSeconds << "), voxel " << result.VoxelSizeUsed
-            << "\n";
+            << ", verification " << result.VerificationSeconds << ", simplification "
+            << result.SimplificationSeconds << ", cage verification "
+            << result.CageVerificationSeconds << "), voxel " << result.VoxelSizeUsed << ", "
+            << result.VerticesReached << " cage vertices\n";
 
   const Normalization& n = result.Normalize;
   const double delta = n.lengthToInput(options.Envelope.clearance());
-  const double limit = n.lengthToInput(2.0 * options.Envelope.IsoValue);
-  const exact::ExactReport r = expectEncloses(input, result.Cage, delta, limit, shape.Name + " cage");
+  // The envelope lies near distance c, so 2c measures its clearance exactly; a coarse cage can be
+  // farther away, so it gets a quarter of the unit radius.
+  const exact::ExactReport env = expectEncloses(input, result.Envelope, delta,
+    n.lengthToInput(2.0 * options.Envelope.IsoValue), shape.Name + " envelope");
+  const exact::ExactReport cage =
+    expectEncloses(input, result.Cage, delta, n.lengthToInput(0.25), shape.Name + " cage");
 
   // Core's own measurements agree with the independent ones.
-  EXPECT_NEAR(result.MinimumClearance, r.MinimumClearance, 1e-6 * r.MinimumClearance);
+  EXPECT_NEAR(result.MinimumClearance, cage.MinimumClearance, 1e-6 * cage.MinimumClearance);
   EXPECT_NEAR(result.MinimumClearanceRelative, n.lengthToUnit(result.MinimumClearance),
     1e-9 * result.MinimumClearanceRelative);
-  EXPECT_EQ(result.EnvelopeGenus, r.CageGenus);
-  EXPECT_EQ(result.EnvelopeComponents, r.CageComponents);
+  EXPECT_EQ(result.EnvelopeGenus, env.CageGenus);
+  EXPECT_EQ(result.EnvelopeComponents, env.CageComponents);
   if (shape.Components >= 0)
   {
-    EXPECT_EQ(r.CageComponents, shape.Components) << "an offset must keep these parts apart";
-    EXPECT_EQ(r.CageGenus, shape.Genus) << "an offset must keep this genus";
+    EXPECT_EQ(env.CageComponents, shape.Components) << "an offset must keep these parts apart";
+    EXPECT_EQ(env.CageGenus, shape.Genus) << "an offset must keep this genus";
+  }
+  // Simplification keeps the envelope's topology (link condition) and hits the vertex count.
+  EXPECT_EQ(cage.CageGenus, env.CageGenus);
+  EXPECT_EQ(cage.CageComponents, env.CageComponents);
+  EXPECT_EQ(static_cast<std::size_t>(result.VerticesReached), result.Cage.Points.size());
+  EXPECT_TRUE(result.TargetReached) << result.StopReason;
+  if (result.TargetReached)
+  {
+    EXPECT_EQ(result.Cage.Points.size(), static_cast<std::size_t>(options.TargetNumberOfVertices));
+  }
+  else
+  {
+    EXPECT_FALSE(result.StopReason.empty());
   }
   EXPECT_LE(result.VoxelSizeUsed, options.Envelope.voxelSize() * (1 + 1e-12));
   EXPECT_GT(result.VoxelSizeUsed, 0.0);
 
-  // Per-point distances: one per cage point, never below the exact triangle clearance, and equal
-  // to a brute-force distance (spot checks).
+  // Per-point distances: one per point, never below the exact triangle clearance, and equal to a
+  // brute-force distance (spot checks).
+  ASSERT_EQ(result.EnvelopeDistanceToInput.size(), result.Envelope.Points.size());
   ASSERT_EQ(result.CageDistanceToInput.size(), result.Cage.Points.size());
   const double smallest =
     *std::min_element(result.CageDistanceToInput.begin(), result.CageDistanceToInput.end());
-  EXPECT_GE(smallest, r.MinimumClearance * (1.0 - 1e-9));
+  EXPECT_GE(smallest, cage.MinimumClearance * (1.0 - 1e-9));
   const std::size_t step = std::max<std::size_t>(1, result.Cage.Points.size() / 40);
   for (std::size_t i = 0; i < result.Cage.Points.size(); i += step)
   {
     const double expected = bruteDistance(input, result.Cage.Points[i]);
     EXPECT_NEAR(result.CageDistanceToInput[i], expected, 1e-9 * expected + 1e-12) << "point " << i;
+  }
+}
+
+TEST(GenerateCage, TargetZeroKeepsTheEnvelope)
+{
+  const TriangleMesh input = makeTorus(Vec3(0, 0, 0), 1.0, 0.35, 64, 24);
+  CageOptions options;
+  options.TargetNumberOfVertices = 0;
+  const CageResult result = generateCage(PolygonMesh::fromTriangles(input), options);
+  ASSERT_EQ(result.State, Status::Ok) << result.Message;
+  EXPECT_EQ(result.Cage.Points, result.Envelope.Points);
+  EXPECT_EQ(result.Cage.Triangles, result.Envelope.Triangles);
+  EXPECT_TRUE(result.TargetReached);
+  EXPECT_EQ(static_cast<std::size_t>(result.VerticesReached), result.Cage.Points.size());
+}
+
+TEST(GenerateCage, OtherVertexCounts)
+{
+  const TriangleMesh input = makeBuiltinShape();
+  for (const int target : { 200, 1000 })
+  {
+    CageOptions options;
+    const int defaultTarget = options.TargetNumberOfVertices;
+    options.TargetNumberOfVertices = target;
+    const CageResult result = generateCage(PolygonMesh::fromTriangles(input), options);
+    ASSERT_EQ(result.State, Status::Ok) << result.Message;
+    EXPECT_EQ(static_cast<std::size_t>(result.VerticesReached), result.Cage.Points.size());
+    if (target >= defaultTarget)
+    {
+      // At least as many vertices as the default (asserted reachable above) must be reachable.
+      EXPECT_TRUE(result.TargetReached) << target << ": " << result.StopReason;
+    }
+    if (result.TargetReached)
+    {
+      EXPECT_EQ(result.Cage.Points.size(), static_cast<std::size_t>(target));
+    }
+    else
+    {
+      // Allowed (DESIGN: "if no feasible collapse remains it says so"), but it must say so.
+      EXPECT_FALSE(result.StopReason.empty());
+      EXPECT_GT(result.VerticesReached, target);
+      std::cout << "[ note     ] target " << target << " not reached: " << result.VerticesReached
+                << " vertices; " << result.StopReason << "\n";
+    }
+    const Normalization& n = result.Normalize;
+    expectEncloses(input, result.Cage, n.lengthToInput(options.Envelope.clearance()),
+      n.lengthToInput(0.25), "builtin cage, " + std::to_string(target) + " vertices");
   }
 }
 
@@ -274,12 +347,22 @@ TEST(Cancel, DuringTheDistanceFieldGivesCancelled)
 
 TEST(Cancel, FromReportLateInTheRunGivesCancelled)
 {
-  Recorder progress;
-  progress.CancelAt = 0.75; // inside verification
-  const CageResult result =
-    generateCage(PolygonMesh::fromTriangles(makeBuiltinShape()), CageOptions(), &progress);
-  EXPECT_EQ(result.State, Status::Cancelled) << statusName(result.State) << ": " << result.Message;
-  EXPECT_FALSE(result.EnclosureVerified);
+  const TriangleMesh input = makeBuiltinShape();
+  for (const double at : { 0.3, 0.6 }) // while building the envelope, while simplifying
+  {
+    Recorder progress;
+    progress.CancelAt = at;
+    const CageResult result = generateCage(PolygonMesh::fromTriangles(input), CageOptions(), &progress);
+    EXPECT_EQ(result.State, Status::Cancelled)
+      << "at " << at << ": " << statusName(result.State) << ": " << result.Message;
+    if (!result.Cage.empty())
+    {
+      // A partial cage handed out after a cancel must still be a valid cage.
+      const Normalization& n = result.Normalize;
+      expectEncloses(input, result.Cage, n.lengthToInput(CageOptions().Envelope.clearance()),
+        n.lengthToInput(0.25), "partial cage after cancel at " + std::to_string(at));
+    }
+  }
 }
 
 TEST(Cancel, BuildEnvelopeDirectly)
