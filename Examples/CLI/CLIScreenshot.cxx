@@ -23,14 +23,19 @@
 #include <vtkTextProperty.h>
 #include <vtkWindowToImageFilter.h>
 
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
+
+#include <unistd.h> // write
 
 namespace sdfcage_cli
 {
 
-/// In CLIDisplay.cxx, the only file that includes Xlib.h (its macros clash with other headers).
-bool canOpenXDisplay();
+/// In CLIDisplay.cxx, the only file that includes Xlib.h (its macros clash with other headers):
+/// the program's one X connection (a Display*), opened once and kept; nullptr on failure.
+void* openXDisplay();
+void closeXDisplay();
 
 namespace
 {
@@ -46,7 +51,7 @@ bool displayReachable(std::string& error)
             "machine run the command under `xvfb-run -a`)";
     return false;
   }
-  if (!canOpenXDisplay())
+  if (!openXDisplay())
   {
     error = std::string("cannot render: cannot open the X display '") + name +
       "' (rendering needs an X server; on a headless machine run the command under "
@@ -78,13 +83,24 @@ bool canRender(std::string& error)
   return displayReachable(error);
 }
 
-bool writeScreenshot(vtkPolyData* input, vtkPolyData* cage, const std::string& title,
+namespace
+{
+
+extern "C" void onAbortWhileRendering(int)
+{
+  // VTK's X render window calls abort() on some failures (e.g. no usable GLX visual) instead of
+  // reporting an error: say what happened before dying (write() is async-signal-safe).
+  static const char message[] = "\nsdfcage: error: VTK aborted while rendering the screenshot "
+                                "(is the X server usable for OpenGL? try `xvfb-run -a`)\n";
+  const ssize_t ignored = write(STDERR_FILENO, message, sizeof(message) - 1);
+  (void)ignored;
+  std::signal(SIGABRT, SIG_DFL);
+  std::raise(SIGABRT);
+}
+
+bool render(vtkPolyData* input, vtkPolyData* cage, const std::string& title,
   const std::string& path, std::string& error)
 {
-  if (!displayReachable(error))
-  {
-    return false;
-  }
   MessageCollector* messages = MessageCollector::SafeDownCast(vtkOutputWindow::GetInstance());
   if (messages)
   {
@@ -92,6 +108,7 @@ bool writeScreenshot(vtkPolyData* input, vtkPolyData* cage, const std::string& t
   }
 
   vtkNew<vtkRenderWindow> window;
+  window->SetDisplayId(openXDisplay()); // our connection: VTK neither opens nor closes one
   window->SetOffScreenRendering(1);
   window->SetSize(1200, 800);
   window->SetMultiSamples(0);
@@ -230,6 +247,8 @@ bool writeScreenshot(vtkPolyData* input, vtkPolyData* cage, const std::string& t
   png->SetInputConnection(grab->GetOutputPort());
   png->Write();
 
+  window->Finalize(); // release the OpenGL context while our X connection is still open
+
   std::error_code ec;
   if (png->GetErrorCode() != 0 || !std::filesystem::exists(path, ec) ||
     (messages && !messages->errors().empty()))
@@ -240,6 +259,22 @@ bool writeScreenshot(vtkPolyData* input, vtkPolyData* cage, const std::string& t
     return false;
   }
   return true;
+}
+
+} // namespace
+
+bool writeScreenshot(vtkPolyData* input, vtkPolyData* cage, const std::string& title,
+  const std::string& path, std::string& error)
+{
+  if (!displayReachable(error))
+  {
+    return false;
+  }
+  void (*previous)(int) = std::signal(SIGABRT, onAbortWhileRendering);
+  const bool ok = render(input, cage, title, path, error); // the window is gone afterwards
+  std::signal(SIGABRT, previous);
+  closeXDisplay();
+  return ok;
 }
 
 } // namespace sdfcage_cli
