@@ -98,6 +98,9 @@ std::string toJson(const RunReport& r)
   key("VoxelSize") << jsonNumber(r.VoxelSize);
   key("MinimumClearance") << jsonNumber(r.MinimumClearance);
   key("MinimumClearanceUsed") << jsonNumber(r.MinimumClearanceUsed);
+  key("NumberOfVertices") << r.NumberOfVertices;
+  key("Adaptivity") << jsonNumber(r.Adaptivity);
+  key("MaximumRefinements") << r.MaximumRefinements;
   key("NumberOfThreads") << r.NumberOfThreads;
   key("InputPoints") << r.InputPoints;
   key("InputCells") << r.InputCells;
@@ -111,6 +114,8 @@ std::string toJson(const RunReport& r)
   key("DistanceFieldTime") << jsonNumber(r.DistanceFieldTime);
   key("IsosurfaceTime") << jsonNumber(r.IsosurfaceTime);
   key("VerificationTime") << jsonNumber(r.VerificationTime);
+  key("SimplificationTime") << jsonNumber(r.SimplificationTime);
+  key("CageVerificationTime") << jsonNumber(r.CageVerificationTime);
   key("TotalTime") << jsonNumber(r.TotalTime);
   key("WriteTime") << jsonNumber(r.WriteTime);
   key("MeasuredClearance") << jsonNumber(r.MeasuredClearance);
@@ -118,6 +123,10 @@ std::string toJson(const RunReport& r)
   key("EnclosureVerified") << (r.EnclosureVerified ? "true" : "false");
   key("RemovedPockets") << r.RemovedPockets;
   key("EnvelopeGenus") << r.EnvelopeGenus;
+  key("EnvelopeComponents") << r.EnvelopeComponents;
+  key("VerticesReached") << r.VerticesReached;
+  key("TargetReached") << (r.TargetReached ? "true" : "false");
+  key("StopReason") << jsonString(r.StopReason);
   key("VoxelSizeUsed") << jsonNumber(r.VoxelSizeUsed);
   key("InputWasFlipped") << (r.InputWasFlipped ? "true" : "false");
   os << "\n}\n";
@@ -160,20 +169,34 @@ void printSummary(std::ostream& os, const RunReport& r)
     return;
   }
   os << "envelope    : " << r.EnvelopePoints << " points, " << r.EnvelopeTriangles
-     << " triangles, genus " << r.EnvelopeGenus << ", " << r.RemovedPockets
-     << " trapped pocket(s) removed\n";
+     << " triangles, " << r.EnvelopeComponents << " component(s), genus " << r.EnvelopeGenus
+     << ", " << r.RemovedPockets << " trapped pocket(s) removed\n";
   os << "cage        : " << r.CagePoints << " points, " << r.CageTriangles << " triangles";
+  if (r.NumberOfVertices > 0)
+  {
+    os << (r.TargetReached ? " (target " : " (target NOT reached: ") << r.NumberOfVertices
+       << (r.TargetReached ? std::string(" reached")
+            : r.StopReason.empty() ? std::string()
+                                   : std::string("; ") + r.StopReason)
+       << ")";
+  }
+  else
+  {
+    os << " (not simplified)";
+  }
   if (!r.OutputFile.empty())
   {
     os << " -> " << r.OutputFile;
   }
   os << "\n";
   os << "voxel size  : " << number(r.VoxelSizeUsed) << " (relative: the input scaled into the "
-     << "unit sphere), isovalue " << number(r.IsoValue) << "\n";
+     << "unit sphere), isovalue " << number(r.IsoValue) << ", adaptivity "
+     << number(r.Adaptivity) << "\n";
   os << "timings     : validation " << seconds(r.ValidationTime) << ", distance field "
      << seconds(r.DistanceFieldTime) << ", isosurface " << seconds(r.IsosurfaceTime)
-     << ", verification " << seconds(r.VerificationTime) << ", total " << seconds(r.TotalTime)
-     << "\n";
+     << ", verification " << seconds(r.VerificationTime) << ",\n              simplification "
+     << seconds(r.SimplificationTime) << ", cage verification "
+     << seconds(r.CageVerificationTime) << ", total " << seconds(r.TotalTime) << "\n";
   os << "clearance   : " << number(r.MeasuredClearance) << " (input units) = "
      << number(r.MeasuredClearanceRelative) << " relative, required >= "
      << number(r.MinimumClearanceUsed) << " relative\n";

@@ -20,6 +20,9 @@ struct RunReport
   double VoxelSize = 0.0;
   double MinimumClearance = 0.0;
   double MinimumClearanceUsed = 0.0; ///< after "0 = automatic"
+  double Adaptivity = 0.0;
+  int NumberOfVertices = 0; ///< the target (0 = no simplification)
+  int MaximumRefinements = 0;
   int NumberOfThreads = 0;
 
   // counts
@@ -37,6 +40,8 @@ struct RunReport
   double DistanceFieldTime = 0.0;
   double IsosurfaceTime = 0.0;
   double VerificationTime = 0.0;
+  double SimplificationTime = 0.0;
+  double CageVerificationTime = 0.0;
   double TotalTime = 0.0;
   double WriteTime = 0.0;
   double MeasuredClearance = 0.0;
@@ -44,6 +49,10 @@ struct RunReport
   bool EnclosureVerified = false;
   int RemovedPockets = 0;
   int EnvelopeGenus = 0;
+  int EnvelopeComponents = 0;
+  int VerticesReached = 0;
+  bool TargetReached = false;
+  std::string StopReason; ///< why the simplification stopped early ("" when it reached N)
   double VoxelSizeUsed = 0.0;
   bool InputWasFlipped = false;
   bool FilterRan = false; ///< false when the run stopped before the filter (e.g. unreadable)

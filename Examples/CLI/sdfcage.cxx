@@ -1,7 +1,7 @@
 // SDFCage — the command-line program: a closed mesh (or the built-in shape) -> its cage.
 //
-//   sdfcage [INPUT] [-o OUT] [--iso C] [--voxel H] [--clearance D] [--refinements N]
-//           [--report FILE.json] [--screenshot FILE.png] [--threads N] [--quiet]
+//   sdfcage [INPUT] [-o OUT] [-n N] [--iso C] [--voxel H] [--clearance D] [--adaptivity A]
+//           [--refinements N] [--report FILE.json] [--screenshot FILE.png] [--threads N] [--quiet]
 //           [--help] [--version]
 //
 // Exit codes: 0 cage written and enclosure verified; 1 enclosure could not be verified;
@@ -61,9 +61,10 @@ void printUsage(std::ostream& os)
   os << "Usage: sdfcage [INPUT] [options]\n"
         "\n"
         "Builds a cage (a coarse closed mesh that strictly encloses the input) from an SDF\n"
-        "envelope and verifies it. INPUT is a closed triangle/polygon mesh: "
+        "envelope, simplified to N vertices, and verifies it. INPUT is a closed mesh file\n"
+        "("
      << supportedExtensions()
-     << ".\n"
+     << ").\n"
         "Without INPUT the built-in shape (a torus beside a sphere) is used.\n"
         "\n"
         "Options (lengths are relative: the input is scaled into the unit sphere):\n"
@@ -72,10 +73,14 @@ void printUsage(std::ostream& os)
      << ")\n"
         "                          default: <input stem>_cage.vtp (builtin_cage.vtp) in the\n"
         "                          current folder\n"
+        "  -n, --vertices N        vertices of the cage, default 500; 0 = no simplification\n"
+        "                          (the cage is the dense verified envelope)\n"
         "      --iso C             isovalue of the envelope, default 0.01\n"
         "      --voxel H           voxel size of the distance grid, default 0 = automatic (C/2)\n"
         "      --clearance D       clearance every cage triangle keeps from the input,\n"
         "                          default 0 = automatic (C/4)\n"
+        "      --adaptivity A      isosurface adaptivity in [0, 1]: 0 uniform triangles, larger\n"
+        "                          merges flat regions (fewer triangles); default 0.1\n"
         "      --refinements N     times the grid may be refined if verification fails, default 2\n"
         "      --report FILE.json  write the results as JSON\n"
         "      --screenshot FILE.png\n"
@@ -100,6 +105,8 @@ struct Options
   double IsoValue = 0.01;
   double VoxelSize = 0.0;
   double Clearance = 0.0;
+  double Adaptivity = -1.0; ///< -1 = the filter's default
+  int Vertices = -1;        ///< -1 = the filter's default
   int Refinements = -1; ///< -1 = the filter's default
   int Threads = 0;
   bool Quiet = false;
@@ -249,6 +256,16 @@ Options parseOptions(int argc, char* argv[], vtkSDFCageFilter* limits)
     {
       o.Clearance = parseDouble(arg, takeValue(), limits->GetMinimumClearanceMinValue(),
         limits->GetMinimumClearanceMaxValue());
+    }
+    else if (arg == "-n" || arg == "--vertices")
+    {
+      o.Vertices = parseInt(arg, takeValue(), limits->GetNumberOfVerticesMinValue(),
+        limits->GetNumberOfVerticesMaxValue());
+    }
+    else if (arg == "--adaptivity")
+    {
+      o.Adaptivity = parseDouble(arg, takeValue(), limits->GetAdaptivityMinValue(),
+        limits->GetAdaptivityMaxValue());
     }
     else if (arg == "--refinements")
     {
@@ -477,10 +494,21 @@ int run(const Options& o, MessageCollector* messages)
   filter->SetIsoValue(o.IsoValue);
   filter->SetVoxelSize(o.VoxelSize);
   filter->SetMinimumClearance(o.Clearance);
+  if (o.Vertices >= 0)
+  {
+    filter->SetNumberOfVertices(o.Vertices);
+  }
+  if (o.Adaptivity >= 0)
+  {
+    filter->SetAdaptivity(o.Adaptivity);
+  }
   if (o.Refinements >= 0)
   {
     filter->SetMaximumRefinements(o.Refinements);
   }
+  r.Adaptivity = filter->GetAdaptivity();
+  r.NumberOfVertices = filter->GetNumberOfVertices();
+  r.MaximumRefinements = filter->GetMaximumRefinements();
   filter->SetNumberOfThreads(o.Threads);
   filter->AddObserver(vtkCommand::ProgressEvent, progress);
   std::signal(SIGINT, onInterrupt);
@@ -496,6 +524,12 @@ int run(const Options& o, MessageCollector* messages)
   r.DistanceFieldTime = filter->GetDistanceFieldTime();
   r.IsosurfaceTime = filter->GetIsosurfaceTime();
   r.VerificationTime = filter->GetVerificationTime();
+  r.SimplificationTime = filter->GetSimplificationTime();
+  r.CageVerificationTime = filter->GetCageVerificationTime();
+  r.VerticesReached = filter->GetVerticesReached();
+  r.TargetReached = filter->GetTargetReached();
+  r.StopReason = filter->GetStopReason();
+  r.EnvelopeComponents = filter->GetEnvelopeComponents();
   r.TotalTime = filter->GetTotalTime();
   r.MeasuredClearance = filter->GetMeasuredClearance();
   r.MeasuredClearanceRelative = filter->GetMeasuredClearanceRelative();
