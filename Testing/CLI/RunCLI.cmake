@@ -5,7 +5,8 @@
 #         -DEXPECT_EXIT=<code> [-DEXPECT_STDERR=<regex>] [-DEXPECT_STDOUT=<regex>]
 #         [-DEXPECT_FILES="f1|f2"] [-DEXPECT_NO_FILES="f1|f2"]
 #         [-DREPORT=<json>] [-DEXPECT_JSON="Key=value|Key=value"] [-DPYTHON=<python>
-#         -DPNG_CHECK=<check_png.py> -DPNG=<file>] -P RunCLI.cmake
+#         -DPNG_CHECK=<check_png.py> -DPNG=<file>]
+#         [-DEXACT_CHECK=<sdfcage_exact_check> -DEXACT_FILES="input|cage"] -P RunCLI.cmake
 #
 # Lists use "|" (a ";" would be split by the command line). Relative file names are in WORKDIR,
 # which is emptied first. SETUP writes a small mesh there (see below). Prints "SKIPPED: ..."
@@ -196,9 +197,10 @@ if (DEFINED REPORT)
       # every result the filter has must be there, under its getter's name
       foreach (key IN ITEMS InputFile OutputFile InputPoints InputTriangles EnvelopePoints
           EnvelopeTriangles CagePoints CageTriangles ValidationTime DistanceFieldTime
-          IsosurfaceTime VerificationTime TotalTime MeasuredClearance MeasuredClearanceRelative
-          EnclosureVerified RemovedPockets EnvelopeGenus VoxelSizeUsed InputWasFlipped Status
-          ExitCode)
+          IsosurfaceTime VerificationTime SimplificationTime CageVerificationTime TotalTime
+          MeasuredClearance MeasuredClearanceRelative EnclosureVerified RemovedPockets
+          EnvelopeGenus EnvelopeComponents VoxelSizeUsed InputWasFlipped VerticesReached
+          TargetReached StopReason NumberOfVertices Status ExitCode)
         string(JSON value ERROR_VARIABLE keyError GET "${json}" "${key}")
         if (keyError)
           list(APPEND failures "report has no key ${key}")
@@ -223,7 +225,13 @@ if (DEFINED REPORT)
             elseif (expected STREQUAL "false")
               set(expected "OFF")
             endif ()
-            if (NOT value STREQUAL expected)
+            # numbers compare as numbers (CMake prints 0.2 back as 0.20000000000000001)
+            set(number_regex "^-?[0-9]+(\\.[0-9]*)?([eE][-+]?[0-9]+)?$")
+            if (value MATCHES "${number_regex}" AND expected MATCHES "${number_regex}")
+              if (NOT value EQUAL expected)
+                list(APPEND failures "report ${key} = ${value}, expected ${expected}")
+              endif ()
+            elseif (NOT value STREQUAL expected)
               list(APPEND failures "report ${key} = '${value}', expected '${expected}'")
             endif ()
           elseif (NOT value GREATER expected)
@@ -254,6 +262,24 @@ if (DEFINED PNG AND NOT failures)
   message("${pngOut}")
   if (NOT pngCode EQUAL 0)
     list(APPEND failures "the screenshot check failed")
+  endif ()
+endif ()
+
+# Independent referee: CGAL's exact predicates on the input and the written cage.
+if (DEFINED EXACT_CHECK AND NOT failures)
+  split_bar(pair "${EXACT_FILES}")
+  set(paths)
+  foreach (f IN LISTS pair)
+    if (NOT IS_ABSOLUTE "${f}")
+      set(f "${WORKDIR}/${f}")
+    endif ()
+    list(APPEND paths "${f}")
+  endforeach ()
+  execute_process(COMMAND "${EXACT_CHECK}" ${paths}
+    RESULT_VARIABLE exactCode OUTPUT_VARIABLE exactOut ERROR_VARIABLE exactErr)
+  message("sdfcage_exact_check: exit code ${exactCode}\n${exactOut}${exactErr}")
+  if (NOT exactCode EQUAL 0)
+    list(APPEND failures "sdfcage_exact_check says the cage does not strictly enclose the input")
   endif ()
 endif ()
 
