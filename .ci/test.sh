@@ -1,0 +1,7 @@
+#!/bin/bash
+# Runs the whole test suite of build/ (configured with .ci/build.sh --tests). ctest runs under
+# xvfb-run so tests that render find an X server; tests needing ../shared/data skip when it is
+# absent.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+xvfb-run -a ctest --test-dir build --output-on-failure "$@"
