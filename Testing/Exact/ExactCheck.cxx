@@ -60,11 +60,6 @@ struct Primitive
   S3 edge(int e) const { return S3(P[e], P[(e + 1) % Size]); }
 };
 
-bool finite(const Vec3& x)
-{
-  return std::isfinite(x[0]) && std::isfinite(x[1]) && std::isfinite(x[2]);
-}
-
 /// Builds the primitive of triangle t; Size 0 when an id is out of range or a point not finite.
 Primitive makePrimitive(const TriangleMesh& mesh, const Triangle& t)
 {
@@ -72,7 +67,7 @@ Primitive makePrimitive(const TriangleMesh& mesh, const Triangle& t)
   const int n = static_cast<int>(mesh.Points.size());
   for (int k = 0; k < 3; ++k)
   {
-    if (t[k] < 0 || t[k] >= n || !finite(mesh.Points[t[k]]))
+    if (t[k] < 0 || t[k] >= n || !mesh.Points[t[k]].allFinite())
     {
       return prim;
     }
@@ -513,7 +508,7 @@ long long countOutside(const TriangleMesh& input, const TriangleMesh& cage,
         valid = false;
         continue;
       }
-      valid = valid && finite(input.Points[v]); // only geometric triangles connect vertices
+      valid = valid && input.Points[v].allFinite(); // only geometric triangles connect vertices
       if (!referenced[v])
       {
         referenced[v] = 1;
@@ -589,7 +584,7 @@ long long countOutside(const TriangleMesh& input, const TriangleMesh& cage,
   CGAL::Side_of_triangle_mesh<Mesh, K> side(mesh);
   auto outsideOf = [&](int v) {
     const Vec3& x = input.Points[v];
-    return !finite(x) || side(P3(x[0], x[1], x[2])) != CGAL::ON_BOUNDED_SIDE;
+    return !x.allFinite() || side(P3(x[0], x[1], x[2])) != CGAL::ON_BOUNDED_SIDE;
   };
   long long outside = 0;
   if (!oneQueryPerComponent)
@@ -608,7 +603,7 @@ long long countOutside(const TriangleMesh& input, const TriangleMesh& cage,
     {
       continue;
     }
-    if (!finite(input.Points[v]))
+    if (!input.Points[v].allFinite())
     {
       ++outside;
       continue;
