@@ -278,7 +278,7 @@ vtkSDFCageFilter::vtkSDFCageFilter()
   // The defaults are Core's, so that the filter, the CLI and the plugin agree.
   const sdfcage::CageOptions cageDefaults;
   const sdfcage::EnvelopeOptions& defaults = cageDefaults.Envelope;
-  this->NumberOfVertices = cageDefaults.TargetNumberOfVertices;
+  this->TargetNumberOfVertices = cageDefaults.TargetNumberOfVertices;
   this->IsoValue = defaults.IsoValue;
   this->VoxelSize = defaults.VoxelSize;
   this->MinimumClearance = defaults.MinimumClearance;
@@ -407,7 +407,7 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
     ToPolygonMesh(input, mesh);
 
     sdfcage::CageOptions options;
-    options.TargetNumberOfVertices = this->NumberOfVertices;
+    options.TargetNumberOfVertices = this->TargetNumberOfVertices;
     options.Envelope.IsoValue = this->IsoValue;
     options.Envelope.VoxelSize = this->VoxelSize;
     options.Envelope.MinimumClearance = this->MinimumClearance;
@@ -486,7 +486,7 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
     if (!result.TargetReached)
     {
       std::ostringstream msg;
-      msg << "the cage has " << result.VerticesReached << " vertices, not the " << this->NumberOfVertices
+      msg << "the cage has " << result.VerticesReached << " vertices, not the " << this->TargetNumberOfVertices
           << " asked for: " << (result.StopReason.empty() ? "no reason given" : result.StopReason);
       warnings.push_back(msg.str());
     }
@@ -538,7 +538,7 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
 void vtkSDFCageFilter::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
-  os << indent << "NumberOfVertices: " << this->NumberOfVertices << "\n";
+  os << indent << "TargetNumberOfVertices: " << this->TargetNumberOfVertices << "\n";
   os << indent << "IsoValue: " << this->IsoValue << "\n";
   os << indent << "VoxelSize: " << this->VoxelSize << "\n";
   os << indent << "MinimumClearance: " << this->MinimumClearance << "\n";

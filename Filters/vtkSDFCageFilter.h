@@ -18,7 +18,7 @@
  * MinimumClearance from every input triangle (exact triangle-triangle distances) and contain
  * every input component; if the check fails, the grid is refined and the envelope rebuilt.
  * Simplification stage (§3.2): constrained quadric-error edge collapses reduce the envelope to
- * NumberOfVertices vertices; every collapse keeps the clearance, avoids self-intersections and
+ * TargetNumberOfVertices vertices; every collapse keeps the clearance, avoids self-intersections and
  * keeps the surface manifold, and the final cage is verified again independently.
  *
  * The input must be a closed (watertight), manifold, consistently oriented surface: polygons and
@@ -52,7 +52,7 @@
  * all outputs are empty. Self-intersecting inputs are not detected. If the envelope or the cage
  * cannot be verified, that is an error too: the cage output stays empty and the envelope (if
  * any) is put on port 1 so the failure can be inspected. If the simplification cannot reach
- * NumberOfVertices (no feasible collapse left), the cage it reached is output with a warning
+ * TargetNumberOfVertices (no feasible collapse left), the cage it reached is output with a warning
  * that gives the reason (GetTargetReached() is false). Empty input is not an error: the outputs
  * are empty. The sampled grid's memory grows as 1/VoxelSize^2 (narrow band); GenerateDistanceField
  * stores a dense grid (1/VoxelSize^3 values).
@@ -82,8 +82,8 @@ public:
    * Number of vertices of the cage (the simplification stops there). 0 skips the
    * simplification: the cage is then the dense verified envelope. Default 500 (Core's).
    */
-  vtkSetClampMacro(NumberOfVertices, int, 0, VTK_INT_MAX);
-  vtkGetMacro(NumberOfVertices, int);
+  vtkSetClampMacro(TargetNumberOfVertices, int, 0, VTK_INT_MAX);
+  vtkGetMacro(TargetNumberOfVertices, int);
   ///@}
 
   ///@{
@@ -170,7 +170,7 @@ public:
   ///@{
   /**
    * Simplification outcome (only valid after the filter has executed): the number of cage
-   * vertices reached, whether it equals NumberOfVertices, and why the simplification stopped
+   * vertices reached, whether it equals TargetNumberOfVertices, and why the simplification stopped
    * early (empty when the target was reached).
    */
   vtkGetMacro(VerticesReached, int);
@@ -222,7 +222,7 @@ protected:
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
   // parameters
-  int NumberOfVertices;
+  int TargetNumberOfVertices;
   double IsoValue;
   double VoxelSize;
   double MinimumClearance;

@@ -98,7 +98,7 @@ std::string toJson(const RunReport& r)
   key("VoxelSize") << jsonNumber(r.VoxelSize);
   key("MinimumClearance") << jsonNumber(r.MinimumClearance);
   key("MinimumClearanceUsed") << jsonNumber(r.MinimumClearanceUsed);
-  key("NumberOfVertices") << r.NumberOfVertices;
+  key("TargetNumberOfVertices") << r.TargetNumberOfVertices;
   key("Adaptivity") << jsonNumber(r.Adaptivity);
   key("MaximumRefinements") << r.MaximumRefinements;
   key("NumberOfThreads") << r.NumberOfThreads;
@@ -172,9 +172,9 @@ void printSummary(std::ostream& os, const RunReport& r)
      << " triangles, " << r.EnvelopeComponents << " component(s), genus " << r.EnvelopeGenus
      << ", " << r.RemovedPockets << " trapped pocket(s) removed\n";
   os << "cage        : " << r.CagePoints << " points, " << r.CageTriangles << " triangles";
-  if (r.NumberOfVertices > 0)
+  if (r.TargetNumberOfVertices > 0)
   {
-    os << (r.TargetReached ? " (target " : " (target NOT reached: ") << r.NumberOfVertices
+    os << (r.TargetReached ? " (target " : " (target NOT reached: ") << r.TargetNumberOfVertices
        << (r.TargetReached ? std::string(" reached")
             : r.StopReason.empty() ? std::string()
                                    : std::string("; ") + r.StopReason)

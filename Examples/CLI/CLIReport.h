@@ -21,7 +21,7 @@ struct RunReport
   double MinimumClearance = 0.0;
   double MinimumClearanceUsed = 0.0; ///< after "0 = automatic"
   double Adaptivity = 0.0;
-  int NumberOfVertices = 0; ///< the target (0 = no simplification)
+  int TargetNumberOfVertices = 0; ///< the target (0 = no simplification)
   int MaximumRefinements = 0;
   int NumberOfThreads = 0;
 

@@ -259,8 +259,8 @@ Options parseOptions(int argc, char* argv[], vtkSDFCageFilter* limits)
     }
     else if (arg == "-n" || arg == "--vertices")
     {
-      o.Vertices = parseInt(arg, takeValue(), limits->GetNumberOfVerticesMinValue(),
-        limits->GetNumberOfVerticesMaxValue());
+      o.Vertices = parseInt(arg, takeValue(), limits->GetTargetNumberOfVerticesMinValue(),
+        limits->GetTargetNumberOfVerticesMaxValue());
     }
     else if (arg == "--adaptivity")
     {
@@ -496,7 +496,7 @@ int run(const Options& o, MessageCollector* messages)
   filter->SetMinimumClearance(o.Clearance);
   if (o.Vertices >= 0)
   {
-    filter->SetNumberOfVertices(o.Vertices);
+    filter->SetTargetNumberOfVertices(o.Vertices);
   }
   if (o.Adaptivity >= 0)
   {
@@ -507,7 +507,7 @@ int run(const Options& o, MessageCollector* messages)
     filter->SetMaximumRefinements(o.Refinements);
   }
   r.Adaptivity = filter->GetAdaptivity();
-  r.NumberOfVertices = filter->GetNumberOfVertices();
+  r.TargetNumberOfVertices = filter->GetTargetNumberOfVertices();
   r.MaximumRefinements = filter->GetMaximumRefinements();
   filter->SetNumberOfThreads(o.Threads);
   filter->AddObserver(vtkCommand::ProgressEvent, progress);

@@ -200,7 +200,7 @@ if (DEFINED REPORT)
           IsosurfaceTime VerificationTime SimplificationTime CageVerificationTime TotalTime
           MeasuredClearance MeasuredClearanceRelative EnclosureVerified RemovedPockets
           EnvelopeGenus EnvelopeComponents VoxelSizeUsed InputWasFlipped VerticesReached
-          TargetReached StopReason NumberOfVertices Status ExitCode)
+          TargetReached StopReason TargetNumberOfVertices Status ExitCode)
         string(JSON value ERROR_VARIABLE keyError GET "${json}" "${key}")
         if (keyError)
           list(APPEND failures "report has no key ${key}")

@@ -156,13 +156,13 @@ void CheckSuccessfulRun(Checker& c, vtkSDFCageFilter* filter, vtkPolyData* input
   vtkPolyData* cageOut = filter->GetOutput(0);
   c.Check(filter->GetVerticesReached() == cageOut->GetNumberOfPoints(),
     "VerticesReached = cage points (" + Str(filter->GetVerticesReached()) + ")");
-  if (filter->GetNumberOfVertices() > 0)
+  if (filter->GetTargetNumberOfVertices() > 0)
   {
     c.Check(filter->GetTargetReached() ==
-        (cageOut->GetNumberOfPoints() == filter->GetNumberOfVertices()),
+        (cageOut->GetNumberOfPoints() == filter->GetTargetNumberOfVertices()),
       "TargetReached agrees with the cage's vertex count");
-    c.Check(cageOut->GetNumberOfPoints() >= filter->GetNumberOfVertices(),
-      "the cage has at least NumberOfVertices vertices");
+    c.Check(cageOut->GetNumberOfPoints() >= filter->GetTargetNumberOfVertices(),
+      "the cage has at least TargetNumberOfVertices vertices");
     c.Check(filter->GetTargetReached() == std::string(filter->GetStopReason()).empty(),
       "a StopReason is given exactly when the target was missed");
   }
@@ -192,7 +192,7 @@ void PrintResults(vtkSDFCageFilter* filter)
   vtkPolyData* cage = filter->GetOutput(0);
   std::cout << "  status " << filter->GetStatusString() << ", cage " << cage->GetNumberOfPoints()
             << " points / " << cage->GetNumberOfPolys() << " triangles (target "
-            << filter->GetNumberOfVertices() << (filter->GetTargetReached() ? " reached" : " missed: ")
+            << filter->GetTargetNumberOfVertices() << (filter->GetTargetReached() ? " reached" : " missed: ")
             << filter->GetStopReason() << "), envelope "
             << filter->GetOutput(1)->GetNumberOfPoints() << " points, genus "
             << filter->GetEnvelopeGenus() << ", pockets removed " << filter->GetRemovedPockets()
@@ -501,7 +501,7 @@ int TestAbort(const Context&)
       std::cout << "  " << tag << "cage of " << cage->GetNumberOfPoints() << " points\n";
       c.Check(CountOpenEdges(cage) == 0, tag + "the cage output is closed");
       c.Check(filter->GetEnclosureVerified(), tag + "the cage output is verified");
-      c.Check(cage->GetNumberOfPoints() >= filter->GetNumberOfVertices(),
+      c.Check(cage->GetNumberOfPoints() >= filter->GetTargetNumberOfVertices(),
         tag + "no fewer vertices than asked");
     }
     // "Promptly": well before a full run would have finished.
@@ -611,8 +611,8 @@ int TestParameters(const Context&)
     "GenerateDistanceField default = Core's");
   c.Check(filter->GetNumberOfThreads() == core.NumberOfThreads, "NumberOfThreads default = Core's");
   c.Check(filter->GetIsoValue() == 0.01, "IsoValue default is the paper's 0.01");
-  c.Check(filter->GetNumberOfVertices() == sdfcage::CageOptions().TargetNumberOfVertices,
-    "NumberOfVertices default = Core's");
+  c.Check(filter->GetTargetNumberOfVertices() == sdfcage::CageOptions().TargetNumberOfVertices,
+    "TargetNumberOfVertices default = Core's");
 
   filter->SetIsoValue(-1.0);
   c.Check(filter->GetIsoValue() > 0, "IsoValue is clamped to a positive value");
@@ -666,18 +666,18 @@ int TestParameters(const Context&)
   }
   c.Check(same, "identical cages with 1 thread and all threads");
 
-  // NumberOfVertices: an explicit target is met exactly; 0 makes the cage the envelope.
-  explicitFilter->SetNumberOfVertices(120);
+  // TargetNumberOfVertices: an explicit target is met exactly; 0 makes the cage the envelope.
+  explicitFilter->SetTargetNumberOfVertices(120);
   explicitFilter->Update();
   PrintResults(explicitFilter);
   CheckSuccessfulRun(c, explicitFilter, input);
   c.Check(explicitFilter->GetOutput(0)->GetNumberOfPoints() == 120, "a 120-vertex cage");
-  explicitFilter->SetNumberOfVertices(0);
+  explicitFilter->SetTargetNumberOfVertices(0);
   explicitFilter->Update();
   CheckSuccessfulRun(c, explicitFilter, input);
   c.Check(explicitFilter->GetOutput(0)->GetNumberOfPoints() ==
       explicitFilter->GetOutput(1)->GetNumberOfPoints(),
-    "NumberOfVertices 0: the cage is the envelope");
+    "TargetNumberOfVertices 0: the cage is the envelope");
   return c.Result();
 }
 

@@ -78,7 +78,7 @@ def main(xml_path):
     # Every settable C++ parameter of the filter has a property (nothing forgotten).
     filter_proxy = [p for p in proxies if p.get("class") == "vtkSDFCageFilter"][0]
     commands = {p.get("command") for p in filter_proxy}
-    for parameter in ("NumberOfVertices", "IsoValue", "VoxelSize", "MinimumClearance", "Adaptivity", "MaximumRefinements",
+    for parameter in ("TargetNumberOfVertices", "IsoValue", "VoxelSize", "MinimumClearance", "Adaptivity", "MaximumRefinements",
                       "GenerateDistanceField", "NumberOfThreads"):
         check("Set" + parameter in commands, "vtkSDFCageFilter.%s has an XML property" % parameter)
     ports = [p.get("name") for p in filter_proxy.findall("OutputPort")]
