@@ -62,8 +62,11 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
   const TriangleMesh unit = n.toUnit(mesh);
 
   // 3. the verified envelope
+  // when the dense envelope is itself the cage, its exact clearance is the one to report
+  EnvelopeOptions envelopeOptions = options.Envelope;
+  envelopeOptions.ExactEnvelopeClearance = envelopeOptions.ExactEnvelopeClearance || options.TargetNumberOfVertices <= 0;
   EnvelopeResult env =
-    buildEnvelope(unit, options.Envelope, progress, options.TargetNumberOfVertices > 0 ? 0.45 : 1.0);
+    buildEnvelope(unit, envelopeOptions, progress, options.TargetNumberOfVertices > 0 ? 0.45 : 1.0);
   result.DistanceFieldSeconds = env.DistanceFieldSeconds;
   result.IsosurfaceSeconds = env.IsosurfaceSeconds;
   result.VerificationSeconds = env.VerificationSeconds;

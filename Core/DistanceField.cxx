@@ -57,7 +57,7 @@ std::once_flag vdbInit;
 } // namespace
 
 IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSize, double iso,
-  bool keepField, Progress* progress, double adaptivity)
+  bool keepField, Progress* progress, const std::vector<double>& adaptivities)
 {
   std::call_once(vdbInit, []() { openvdb::initialize(); });
   IsosurfaceOutput out;
@@ -106,46 +106,50 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
   out.ActiveVoxels = grid->activeVoxelCount();
 
   auto t1 = std::chrono::steady_clock::now();
-  std::vector<openvdb::Vec3s> meshPoints;
-  std::vector<openvdb::Vec3I> meshTris;
-  std::vector<openvdb::Vec4I> meshQuads;
-  try
+  for (const double adaptivity : adaptivities)
   {
-    openvdb::tools::volumeToMesh(*grid, meshPoints, meshTris, meshQuads, iso, adaptivity, true);
-  }
-  catch (const std::exception& e)
-  {
-    out.Error = std::string("OpenVDB could not extract the isosurface: ") + e.what();
-    return out;
+    std::vector<openvdb::Vec3s> meshPoints;
+    std::vector<openvdb::Vec3I> meshTris;
+    std::vector<openvdb::Vec4I> meshQuads;
+    try
+    {
+      openvdb::tools::volumeToMesh(*grid, meshPoints, meshTris, meshQuads, iso, adaptivity, true);
+    }
+    catch (const std::exception& e)
+    {
+      out.Error = std::string("OpenVDB could not extract the isosurface: ") + e.what();
+      return out;
+    }
+    out.Surfaces.emplace_back();
+    TriangleMesh& s = out.Surfaces.back();
+    s.Points.resize(meshPoints.size());
+    for (std::size_t i = 0; i < meshPoints.size(); ++i)
+    {
+      s.Points[i] = Vec3(meshPoints[i].x(), meshPoints[i].y(), meshPoints[i].z());
+    }
+    s.Triangles.reserve(meshTris.size() + 2 * meshQuads.size());
+    // OpenVDB's polygons wind clockwise seen from outside; we store counter-clockwise.
+    for (const auto& t : meshTris)
+    {
+      s.Triangles.push_back({ static_cast<int>(t[0]), static_cast<int>(t[2]), static_cast<int>(t[1]) });
+    }
+    for (const auto& q : meshQuads)
+    {
+      const int a = q[0], b = q[1], c = q[2], d = q[3];
+      // split along the shorter diagonal (better-shaped triangles)
+      if ((s.Points[a] - s.Points[c]).squaredNorm() <= (s.Points[b] - s.Points[d]).squaredNorm())
+      {
+        s.Triangles.push_back({ a, c, b });
+        s.Triangles.push_back({ a, d, c });
+      }
+      else
+      {
+        s.Triangles.push_back({ a, d, b });
+        s.Triangles.push_back({ b, d, c });
+      }
+    }
   }
   progressUpdate(progress, 0.9);
-  TriangleMesh& s = out.Surface;
-  s.Points.resize(meshPoints.size());
-  for (std::size_t i = 0; i < meshPoints.size(); ++i)
-  {
-    s.Points[i] = Vec3(meshPoints[i].x(), meshPoints[i].y(), meshPoints[i].z());
-  }
-  s.Triangles.reserve(meshTris.size() + 2 * meshQuads.size());
-  // OpenVDB's polygons wind clockwise seen from outside; we store counter-clockwise.
-  for (const auto& t : meshTris)
-  {
-    s.Triangles.push_back({ static_cast<int>(t[0]), static_cast<int>(t[2]), static_cast<int>(t[1]) });
-  }
-  for (const auto& q : meshQuads)
-  {
-    const int a = q[0], b = q[1], c = q[2], d = q[3];
-    // split along the shorter diagonal (better-shaped triangles)
-    if ((s.Points[a] - s.Points[c]).squaredNorm() <= (s.Points[b] - s.Points[d]).squaredNorm())
-    {
-      s.Triangles.push_back({ a, c, b });
-      s.Triangles.push_back({ a, d, c });
-    }
-    else
-    {
-      s.Triangles.push_back({ a, d, b });
-      s.Triangles.push_back({ b, d, c });
-    }
-  }
 
   if (keepField)
   {

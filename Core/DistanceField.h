@@ -6,6 +6,7 @@
 #include "Mesh.h"
 
 #include <string>
+#include <vector>
 
 namespace sdfcage
 {
@@ -14,7 +15,8 @@ class Progress;
 
 struct IsosurfaceOutput
 {
-  TriangleMesh Surface;   ///< the isosurface {xi = iso}, triangles (quads split), unit units
+  /// the isosurface {xi = iso} for each requested adaptivity, triangles (quads split), unit units
+  std::vector<TriangleMesh> Surfaces;
   ScalarImage Field;      ///< dense samples of xi, when requested
   bool Cancelled = false;
   std::string Error;
@@ -27,6 +29,6 @@ struct IsosurfaceOutput
 /// fill), wide enough outside for `iso`, then marching-cubes-style extraction at `iso`.
 /// Progress: fractions 0..0.6 for the SDF, 0.6..1 for the surface of the current stage.
 IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSize, double iso,
-  bool keepField, Progress* progress, double adaptivity = 0.0);
+  bool keepField, Progress* progress, const std::vector<double>& adaptivities = { 0.0 });
 
 } // namespace sdfcage

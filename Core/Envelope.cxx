@@ -3,6 +3,7 @@
 #include "DistanceField.h"
 #include "Geometry.h"
 #include "Progress.h"
+#include "TriangleIndex.h"
 #include "TriangleTree.h"
 #include "Validation.h"
 
@@ -127,8 +128,46 @@ TriangleMesh outerBoundary(const TriangleMesh& surface, int& removed)
 
 } // namespace
 
+long long countSelfIntersections(const TriangleMesh& mesh, Progress* progress)
+{
+  TriangleIndex index;
+  index.build(mesh);
+  const std::size_t nf = mesh.Triangles.size();
+  // exact-intersection fold test for edge-sharing pairs: only exactly opposite normals overlap
+  const double foldCosine = -1.0 + 1e-12;
+  return tbb::parallel_reduce(
+    tbb::blocked_range<std::size_t>(0, nf, 2048), 0LL,
+    [&](const tbb::blocked_range<std::size_t>& r, long long count) {
+      if (progressCancelled(progress))
+      {
+        return count;
+      }
+      for (std::size_t f = r.begin(); f != r.end(); ++f)
+      {
+        const Triangle& t = mesh.Triangles[f];
+        const int ia[3] = { t[0], t[1], t[2] };
+        const Vec3 pa[3] = { mesh.Points[t[0]], mesh.Points[t[1]], mesh.Points[t[2]] };
+        const Vec3 lo = pa[0].cwiseMin(pa[1]).cwiseMin(pa[2]);
+        const Vec3 hi = pa[0].cwiseMax(pa[1]).cwiseMax(pa[2]);
+        index.forEachTriangleInBox(lo, hi, [&](int g) {
+          if (static_cast<std::size_t>(g) <= f)
+          {
+            return;
+          }
+          const Triangle& o = mesh.Triangles[g];
+          const int ib[3] = { o[0], o[1], o[2] };
+          const Vec3 pb[3] = { mesh.Points[o[0]], mesh.Points[o[1]], mesh.Points[o[2]] };
+          count += trianglesConflict(ia, pa, ib, pb, 0.0, foldCosine);
+        });
+      }
+      return count;
+    },
+    [](long long a, long long b) { return a + b; });
+}
+
 bool verifyEnclosure(const TriangleMesh& input, const TriangleMesh& cage, double clearance,
-  double& measuredClearance, std::string& why, std::vector<double>* pointDistances, Progress* progress)
+  double& measuredClearance, std::string& why, std::vector<double>* pointDistances, Progress* progress,
+  bool exactMinimum)
 {
   measuredClearance = 0.0;
   why.clear();
@@ -136,6 +175,12 @@ bool verifyEnclosure(const TriangleMesh& input, const TriangleMesh& cage, double
   if (!d.usable())
   {
     why = "the surface is not a closed 2-manifold: " + d.errorMessage();
+    return false;
+  }
+  const long long selfIntersections = countSelfIntersections(cage, progress);
+  if (selfIntersections > 0)
+  {
+    why = "the surface intersects itself (" + std::to_string(selfIntersections) + " triangle pairs)";
     return false;
   }
   const TriangleTree index(input);
@@ -169,9 +214,13 @@ bool verifyEnclosure(const TriangleMesh& input, const TriangleMesh& cage, double
 
   // 2. per triangle, a Lipschitz lower bound from its corners: the distance to the input changes
   // by at most the distance travelled. Exact triangle-triangle distances only where the bound
-  // does not already prove the triangle both clear of delta and above the running minimum.
+  // does not already settle the question: for the exact minimum, every triangle whose bound is
+  // below the best value so far; for certification, every triangle whose bound is below delta
+  // (and then only up to delta, which the tree answers quickly).
+  const double stopAt = exactMinimum ? upper : clearance;
   const std::size_t nf = cage.Triangles.size();
   std::vector<std::pair<double, int>> uncertain; // (lower bound, triangle)
+  double certified = upper;
   for (std::size_t f = 0; f < nf; ++f)
   {
     const Triangle& t = cage.Triangles[f];
@@ -182,19 +231,24 @@ bool verifyEnclosure(const TriangleMesh& input, const TriangleMesh& cage, double
       const double reach = std::max((cage.Points[t[(i + 1) % 3]] - p).norm(), (cage.Points[t[(i + 2) % 3]] - p).norm());
       lower = std::max(lower, dist[t[i]] - reach);
     }
-    if (lower < upper)
+    if (lower < stopAt)
     {
       uncertain.emplace_back(lower, static_cast<int>(f));
+    }
+    else
+    {
+      certified = std::min(certified, lower);
     }
   }
   std::sort(uncertain.begin(), uncertain.end());
   // process in increasing lower-bound order, in parallel chunks, stopping once the bound passes
   // the best exact value found so far
-  std::atomic<double> best{ upper };
+  std::atomic<double> best{ exactMinimum ? upper : clearance };
   const std::size_t chunk = 4096;
+  std::atomic<double> certifiedUncertain{ std::numeric_limits<double>::infinity() };
   for (std::size_t b = 0; b < uncertain.size(); b += chunk)
   {
-    if (uncertain[b].first >= best.load())
+    if (exactMinimum && uncertain[b].first >= best.load())
     {
       break;
     }
@@ -207,8 +261,8 @@ bool verifyEnclosure(const TriangleMesh& input, const TriangleMesh& cage, double
     tbb::parallel_for(tbb::blocked_range<std::size_t>(b, e, 64), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t k = r.begin(); k != r.end(); ++k)
       {
-        const double limit = best.load();
-        if (uncertain[k].first >= limit)
+        const double limit = exactMinimum ? best.load() : clearance;
+        if (exactMinimum && uncertain[k].first >= limit)
         {
           continue;
         }
@@ -219,9 +273,23 @@ bool verifyEnclosure(const TriangleMesh& input, const TriangleMesh& cage, double
         while (dd < cur && !best.compare_exchange_weak(cur, dd))
         {
         }
+        if (!exactMinimum)
+        {
+          // certified: at least max(its bound, delta) unless closer than delta
+          const double value = dd < clearance ? dd : std::max(uncertain[k].first, clearance);
+          double c2 = certifiedUncertain.load();
+          while (value < c2 && !certifiedUncertain.compare_exchange_weak(c2, value))
+          {
+          }
+        }
       }
     });
     progressUpdate(progress, 0.6 + 0.3 * static_cast<double>(e) / static_cast<double>(uncertain.size()));
+  }
+  if (!exactMinimum && best.load() >= clearance)
+  {
+    // nothing closer than delta: report the certified lower bound
+    best.store(std::min(certified, certifiedUncertain.load()));
   }
   measuredClearance = best.load();
   if (pointDistances)
@@ -285,10 +353,20 @@ EnvelopeResult buildEnvelope(
     result.Message = "invalid parameters: need IsoValue > 0, VoxelSize > 0 and 0 < MinimumClearance < IsoValue";
     return result;
   }
-  for (int attempt = 0; attempt <= std::max(0, options.MaximumRefinements); ++attempt, h *= 0.5)
+  // Attempts: the requested grid, first with the requested adaptivity and, if that envelope fails
+  // verification (merged polygons can cut corners or cross), without it from the same field; then
+  // finer grids without adaptivity.
+  int attempt = 0;
+  const int levels = 1 + std::max(0, options.MaximumRefinements);
+  for (int level = 0; level < levels; ++level, h *= 0.5)
   {
+    std::vector<double> adaptivities{ 0.0 };
+    if (level == 0 && options.Adaptivity > 0)
+    {
+      adaptivities = { options.Adaptivity, 0.0 };
+    }
     progressStage(progress, "distance field and isosurface", 0.02, 0.7 * progressEnd);
-    IsosurfaceOutput iso = computeIsosurface(unitInput, h, c, options.KeepDistanceField, progress, options.Adaptivity);
+    IsosurfaceOutput iso = computeIsosurface(unitInput, h, c, options.KeepDistanceField, progress, adaptivities);
     result.DistanceFieldSeconds += iso.DistanceFieldSeconds;
     result.IsosurfaceSeconds += iso.IsosurfaceSeconds;
     if (iso.Cancelled)
@@ -303,43 +381,48 @@ EnvelopeResult buildEnvelope(
       result.Message = iso.Error;
       return result;
     }
-    auto t0 = std::chrono::steady_clock::now();
-    result.Envelope = outerBoundary(iso.Surface, result.RemovedPockets);
-    result.IsosurfaceSeconds += seconds(t0);
-    result.VoxelSizeUsed = h;
-    result.Refinements = attempt;
     result.DistanceField = std::move(iso.Field);
+    for (std::size_t k = 0; k < iso.Surfaces.size(); ++k, ++attempt)
+    {
+      auto t0 = std::chrono::steady_clock::now();
+      result.Envelope = outerBoundary(iso.Surfaces[k], result.RemovedPockets);
+      result.IsosurfaceSeconds += seconds(t0);
+      result.VoxelSizeUsed = h;
+      result.Refinements = attempt;
+      result.AdaptivityUsed = adaptivities[k];
 
-    progressStage(progress, "verifying enclosure", 0.7 * progressEnd, progressEnd);
-    auto t1 = std::chrono::steady_clock::now();
-    std::string why;
-    const bool ok = verifyEnclosure(unitInput, result.Envelope, delta, result.MinimumClearance, why,
-      &result.DistanceToInput, progress);
-    result.VerificationSeconds += seconds(t1);
-    if (progressCancelled(progress))
-    {
-      result.State = Status::Cancelled;
-      result.Message = "cancelled";
-      return result;
+      progressStage(progress, "verifying enclosure", 0.7 * progressEnd, progressEnd);
+      auto t1 = std::chrono::steady_clock::now();
+      std::string why;
+      const bool ok = verifyEnclosure(unitInput, result.Envelope, delta, result.MinimumClearance, why,
+        &result.DistanceToInput, progress, options.ExactEnvelopeClearance);
+      result.VerificationSeconds += seconds(t1);
+      if (progressCancelled(progress))
+      {
+        result.State = Status::Cancelled;
+        result.Message = "cancelled";
+        return result;
+      }
+      if (ok)
+      {
+        std::vector<int> comp;
+        result.Components = triangleComponents(result.Envelope, comp);
+        result.Genus = genus(result.Envelope);
+        result.EnclosureVerified = true;
+        result.State = Status::Ok;
+        result.Message.clear();
+        return result;
+      }
+      std::ostringstream s;
+      s << "envelope at voxel size " << h << " (adaptivity " << adaptivities[k]
+        << ") failed verification: " << why;
+      result.Message = s.str();
     }
-    if (ok)
-    {
-      std::vector<int> comp;
-      result.Components = triangleComponents(result.Envelope, comp);
-      result.Genus = genus(result.Envelope);
-      result.EnclosureVerified = true;
-      result.State = Status::Ok;
-      result.Message.clear();
-      return result;
-    }
-    std::ostringstream s;
-    s << "envelope at voxel size " << h << " failed verification: " << why;
-    result.Message = s.str();
   }
   result.State = Status::VerificationFailed;
   result.EnclosureVerified = false;
-  result.Message += " (after refining the grid " + std::to_string(options.MaximumRefinements) +
-    " times; try a larger IsoValue or a smaller VoxelSize)";
+  result.Message += " (after " + std::to_string(attempt) +
+    " attempts with finer grids; try a larger IsoValue or a smaller VoxelSize)";
   return result;
 }
 

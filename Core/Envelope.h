@@ -30,6 +30,9 @@ struct EnvelopeOptions
   double Adaptivity = 0.1;
   /// If verification fails, retry up to this many times with half the voxel size.
   int MaximumRefinements = 2;
+  /// Measure the envelope's exact minimum clearance (costly on a dense envelope) instead of
+  /// certifying that it is at least the clearance (a certified lower bound is reported then).
+  bool ExactEnvelopeClearance = false;
   /// Keep the sampled SDF as a dense image (for display).
   bool KeepDistanceField = false;
   /// Worker threads (0 = all cores).
@@ -66,13 +69,14 @@ struct EnvelopeResult
   std::string Message;              ///< what went wrong (empty when Ok)
   TriangleMesh Envelope;            ///< outer envelope, outward oriented, unit-sphere units
   std::vector<double> DistanceToInput; ///< per envelope point, unsigned, unit-sphere units
-  double MinimumClearance = 0.0;    ///< exact min triangle-triangle distance, unit-sphere units
+  double MinimumClearance = 0.0;    ///< exact min distance to the input (ExactEnvelopeClearance) or a certified lower bound >= delta, unit-sphere units
   bool EnclosureVerified = false;   ///< clearance >= delta, input inside, closed manifold
   int RemovedPockets = 0;           ///< trapped air pockets (inner components) removed
   int Components = 0;               ///< components of the kept envelope
   int Genus = 0;                    ///< genus of the kept envelope
   double VoxelSizeUsed = 0.0;       ///< after any refinement
-  int Refinements = 0;              ///< how often the grid had to be refined
+  int Refinements = 0;              ///< extra attempts needed (adaptivity off, finer grids)
+  double AdaptivityUsed = 0.0;      ///< adaptivity of the accepted envelope
   double DistanceFieldSeconds = 0.0;
   double IsosurfaceSeconds = 0.0;
   double VerificationSeconds = 0.0;
@@ -84,12 +88,17 @@ struct EnvelopeResult
 EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOptions& options,
   Progress* progress = nullptr, double progressEnd = 1.0);
 
-/// Independent check used by buildEnvelope and by tests: closed 2-manifold, every triangle of
+/// Pairs of triangles of `mesh` that intersect (beyond shared vertices/edges). Threaded.
+long long countSelfIntersections(const TriangleMesh& mesh, Progress* progress = nullptr);
+
+/// Independent check used by buildEnvelope and by tests: closed 2-manifold without
+/// self-intersections, every triangle of
 /// `cage` at least `clearance` from `input` (exact distances), and one point of every input
 /// component inside (winding number). Returns the measured exact minimum clearance in
-/// `measuredClearance` and per-cage-point distances in `pointDistances` (if non-null).
+/// `measuredClearance` (with exactMinimum; otherwise a certified lower bound >= clearance, much
+/// cheaper on dense surfaces) and per-cage-point exact distances in `pointDistances` (if non-null).
 bool verifyEnclosure(const TriangleMesh& input, const TriangleMesh& cage, double clearance,
   double& measuredClearance, std::string& why, std::vector<double>* pointDistances = nullptr,
-  Progress* progress = nullptr);
+  Progress* progress = nullptr, bool exactMinimum = true);
 
 } // namespace sdfcage

@@ -149,6 +149,70 @@ double triangleTriangleDistance2(const Vec3 a[3], const Vec3 b[3])
   return best;
 }
 
+namespace
+{
+// Is direction u inside the (closed) corner angle spanned by e1, e2 (normal n = e1 x e2)?
+bool inCorner(const Vec3& u, const Vec3& e1, const Vec3& e2, const Vec3& n)
+{
+  return e1.cross(u).dot(n) >= 0 && u.cross(e2).dot(n) >= 0;
+}
+} // namespace
+
+bool meetBeyondSharedVertex(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& e)
+{
+  const Vec3 n1 = (b - a).cross(c - a), n2 = (d - a).cross(e - a);
+  const Vec3 u = n1.cross(n2);
+  const double scale = n1.norm() * n2.norm();
+  if (!(scale > 0))
+  {
+    return true;
+  }
+  if (u.norm() <= 1e-9 * scale)
+  {
+    // (nearly) coplanar: they overlap beyond a when the corner angles overlap
+    const Vec3 n = n1.normalized();
+    return inCorner(d - a, b - a, c - a, n) || inCorner(e - a, b - a, c - a, n) ||
+      inCorner(b - a, d - a, e - a, n) || inCorner(c - a, d - a, e - a, n);
+  }
+  // the planes meet in the line a + s u; both triangles contain a piece of it on the same side
+  return (inCorner(u, b - a, c - a, n1) && inCorner(u, d - a, e - a, n2)) ||
+    (inCorner(-u, b - a, c - a, n1) && inCorner(-u, d - a, e - a, n2));
+}
+
+bool trianglesConflict(const int ia[3], const Vec3 pa[3], const int ib[3], const Vec3 pb[3],
+  double separation, double foldCosine)
+{
+  int sa[3], sb[3], shared = 0;
+  for (int i = 0; i < 3; ++i)
+  {
+    for (int j = 0; j < 3; ++j)
+    {
+      if (ia[i] == ib[j])
+      {
+        sa[shared] = i;
+        sb[shared] = j;
+        ++shared;
+      }
+    }
+  }
+  if (shared == 0)
+  {
+    const double d2 = triangleTriangleDistance2(pa, pb);
+    return d2 == 0.0 || d2 < separation * separation;
+  }
+  if (shared == 1)
+  {
+    const int i = sa[0], j = sb[0];
+    return meetBeyondSharedVertex(pa[i], pa[(i + 1) % 3], pa[(i + 2) % 3], pb[(j + 1) % 3], pb[(j + 2) % 3]);
+  }
+  if (shared == 2)
+  {
+    const Vec3 na = (pa[1] - pa[0]).cross(pa[2] - pa[0]), nb = (pb[1] - pb[0]).cross(pb[2] - pb[0]);
+    return na.dot(nb) < foldCosine * na.norm() * nb.norm();
+  }
+  return true; // the same three vertices twice
+}
+
 double windingNumber(const TriangleMesh& mesh, const Vec3& p)
 {
   // Sum of signed solid angles (Van Oosterom & Strackee), divided by 4 pi.

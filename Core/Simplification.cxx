@@ -4,8 +4,6 @@
 #include "Progress.h"
 #include "TriangleTree.h"
 
-#include <Eigen/Eigenvalues>
-
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -61,14 +59,15 @@ struct Quadric
     Eigen::Matrix3d m;
     m << A[0], A[1], A[2], A[1], A[4], A[5], A[2], A[5], A[7];
     const Eigen::Vector3d b(-A[3], -A[6], -A[8]);
-    // accept only well-conditioned systems (flat or cylindrical regions have no unique optimum)
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> es(m);
-    const Eigen::Vector3d ev = es.eigenvalues();
-    if (!(ev(2) > 0) || ev(0) < 1e-6 * ev(2))
+    // accept only well-conditioned systems: flat or cylindrical regions have no unique optimum
+    // (det is the product of the eigenvalues, trace^3/27 the cube of their mean)
+    const double tr = m.trace();
+    const double det = m.determinant();
+    if (!(tr > 0) || !(det > 1e-9 * tr * tr * tr / 27.0))
     {
       return false;
     }
-    v = es.eigenvectors() * ((es.eigenvectors().transpose() * b).cwiseQuotient(ev));
+    v = m.inverse() * b;
     return v.allFinite();
   }
 };
@@ -170,32 +169,8 @@ double triangleQuality(const Vec3& a, const Vec3& b, const Vec3& c)
   return s > 0 ? 2.0 * std::sqrt(3.0) * area2 / s : 0.0;
 }
 
-// Is direction u inside the (closed) corner angle spanned by e1, e2 (normal n = e1 x e2)?
-bool inCorner(const Vec3& u, const Vec3& e1, const Vec3& e2, const Vec3& n)
-{
-  return e1.cross(u).dot(n) >= 0 && u.cross(e2).dot(n) >= 0;
-}
-
-// Two triangles sharing exactly the vertex a: do they meet anywhere else? (conservative: nearly
-// coplanar pairs count as meeting)
-bool meetBeyondSharedVertex(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& e)
-{
-  const Vec3 n1 = (b - a).cross(c - a), n2 = (d - a).cross(e - a);
-  const Vec3 u = n1.cross(n2);
-  const double scale = n1.norm() * n2.norm();
-  if (!(scale > 0))
-    return true;
-  if (u.norm() <= 1e-9 * scale)
-  {
-    // coplanar: they overlap beyond a if the corner angles overlap
-    const Vec3 n = n1.normalized();
-    return inCorner(d - a, b - a, c - a, n) || inCorner(e - a, b - a, c - a, n) ||
-      inCorner(b - a, d - a, e - a, n) || inCorner(c - a, d - a, e - a, n);
-  }
-  // the planes meet in the line a + s u; both triangles contain a piece of it on the same side
-  return (inCorner(u, b - a, c - a, n1) && inCorner(u, d - a, e - a, n2)) ||
-    (inCorner(-u, b - a, c - a, n1) && inCorner(-u, d - a, e - a, n2));
-}
+// Neighbouring cage triangles whose dihedral angle closes below ~18 degrees count as folded.
+constexpr double FoldCosine = -0.95;
 
 class Simplifier
 {
@@ -214,6 +189,7 @@ public:
       for (int v : T[f])
         VT[v].push_back(static_cast<int>(f));
     Ver.assign(P.size(), 0);
+    BlockedAt.assign(P.size(), {});
     Mark.assign(T.size(), 0);
     AliveVertices = static_cast<int>(P.size());
     AliveTriangles = static_cast<int>(T.size());
@@ -310,6 +286,7 @@ private:
   std::vector<int> neighbours(int v) const
   {
     std::vector<int> n;
+    n.reserve(16);
     for (int f : VT[v])
       for (int w : T[f])
         if (w != v)
@@ -354,7 +331,16 @@ private:
     Heap.push({ std::max(0.0, bestCost), a, b, Ver[a], Ver[b], best });
   }
 
-  void block(int a, int b) { Blocked.insert(edgeKey(a, b)); }
+  // A blocked edge is retried when its neighbourhood changes: it is filed under both endpoints
+  // and re-queued when a collapse lands next to either of them.
+  void block(int a, int b)
+  {
+    if (Blocked.insert(edgeKey(a, b)).second)
+    {
+      BlockedAt[a].push_back(b);
+      BlockedAt[b].push_back(a);
+    }
+  }
 
   // ---- the collapse being evaluated (v0 survives, v1 goes) ----
   int C0 = -1, C1 = -1;
@@ -433,69 +419,87 @@ private:
       const Triangle& old = T[Changed[i]];
       const Vec3 no = (P[old[1]] - P[old[0]]).cross(P[old[2]] - P[old[0]]);
       nt.N = (nt.Pts[1] - nt.Pts[0]).cross(nt.Pts[2] - nt.Pts[0]);
+      nt.C = (nt.Pts[0] + nt.Pts[1] + nt.Pts[2]) / 3.0;
+      nt.R = std::max({ (nt.Pts[0] - nt.C).norm(), (nt.Pts[1] - nt.C).norm(), (nt.Pts[2] - nt.C).norm() });
       if (no.dot(nt.N) <= Opt.MinimumNormalCosine * no.norm() * nt.N.norm())
         return Verdict::Shape;
     }
     // among the new triangles (they all share v0): no folds, no crossings
-    for (std::size_t i = 0; i < NewTris.size(); ++i)
+    for (std::size_t i = 0; i < NewTris.size() && Opt.EnforceNoSelfIntersection; ++i)
       for (std::size_t j = i + 1; j < NewTris.size(); ++j)
-        if (pairConflict(NewTris[i].Ids, NewTris[i].Pts, NewTris[j].Ids, NewTris[j].Pts, selfDelta))
+        if (trianglesConflict(NewTris[i].Ids, NewTris[i].Pts, NewTris[j].Ids, NewTris[j].Pts, selfDelta, FoldCosine))
           return Verdict::Self;
-    // the input: clearance delta, exact triangle-triangle distances through the tree
+    // the input: clearance delta. Early-out (the distance to the input is 1-Lipschitz): every new
+    // triangle lies within `reach` of p (its farthest point from p is a corner), so if no input
+    // lies within delta + reach of p, all of them are clear. Otherwise exact triangle-triangle
+    // distances through the tree.
+    if (Opt.EnforceClearance)
+    {
+      double reach = 0;
+      for (const auto& nt : NewTris)
+        for (const Vec3& q : nt.Pts)
+          reach = std::max(reach, (q - p).norm());
+      Vec3 c;
+      int tri;
+      double d;
+      if (Input.closestPoint(p, delta + reach, c, tri, d))
+        for (const auto& nt : NewTris)
+          if (Input.anyCloserThan(nt.Pts, delta))
+            return Verdict::Input;
+    }
+    if (!Opt.EnforceNoSelfIntersection)
+      return Verdict::Ok;
+    // the rest of the cage: one grid query for the whole new one-ring, then per pair a box test,
+    // a bounding-sphere test for disjoint triangles, and the exact conflict test
+    Vec3 ringLo = Vec3::Constant(std::numeric_limits<double>::infinity()), ringHi = -ringLo;
     for (const auto& nt : NewTris)
-      if (Input.anyCloserThan(nt.Pts, delta))
-        return Verdict::Input;
-    // the rest of the cage
+      for (const Vec3& q : nt.Pts)
+      {
+        ringLo = ringLo.cwiseMin(q);
+        ringHi = ringHi.cwiseMax(q);
+      }
+    ringLo -= Vec3::Constant(selfDelta);
+    ringHi += Vec3::Constant(selfDelta);
+    Candidates.clear();
+    ++QueryId;
+    Grid.query(ringLo, ringHi, [&](int f) {
+      if (!TAlive[f] || Mark[f] == MarkId || Seen[f] == QueryId)
+        return;
+      Seen[f] = QueryId;
+      Candidate c;
+      c.F = f;
+      for (int k = 0; k < 3; ++k)
+      {
+        c.Ids[k] = T[f][k];
+        c.Pts[k] = P[T[f][k]];
+      }
+      c.Lo = c.Pts[0].cwiseMin(c.Pts[1]).cwiseMin(c.Pts[2]);
+      c.Hi = c.Pts[0].cwiseMax(c.Pts[1]).cwiseMax(c.Pts[2]);
+      if ((c.Lo.array() > ringHi.array()).any() || (c.Hi.array() < ringLo.array()).any())
+        return;
+      c.C = (c.Pts[0] + c.Pts[1] + c.Pts[2]) / 3.0;
+      c.R = std::max({ (c.Pts[0] - c.C).norm(), (c.Pts[1] - c.C).norm(), (c.Pts[2] - c.C).norm() });
+      Candidates.push_back(c);
+    });
     for (const auto& nt : NewTris)
     {
       const Vec3 lo = nt.Pts[0].cwiseMin(nt.Pts[1]).cwiseMin(nt.Pts[2]) - Vec3::Constant(selfDelta);
       const Vec3 hi = nt.Pts[0].cwiseMax(nt.Pts[1]).cwiseMax(nt.Pts[2]) + Vec3::Constant(selfDelta);
-      bool conflict = false;
-      ++QueryId;
-      Grid.query(lo, hi, [&](int f) {
-        if (conflict || !TAlive[f] || Mark[f] == MarkId || Seen[f] == QueryId)
-          return;
-        Seen[f] = QueryId;
-        const Vec3 op[3] = { P[T[f][0]], P[T[f][1]], P[T[f][2]] };
-        const Vec3 olo = op[0].cwiseMin(op[1]).cwiseMin(op[2]), ohi = op[0].cwiseMax(op[1]).cwiseMax(op[2]);
-        if ((olo.array() > hi.array()).any() || (ohi.array() < lo.array()).any())
-          return;
-        const int oid[3] = { T[f][0], T[f][1], T[f][2] };
-        conflict = pairConflict(nt.Ids, nt.Pts, oid, op, selfDelta);
-      });
-      if (conflict)
-        return Verdict::Self;
+      for (const Candidate& c : Candidates)
+      {
+        if ((c.Lo.array() > hi.array()).any() || (c.Hi.array() < lo.array()).any())
+          continue;
+        const bool disjoint = !(c.Ids[0] == nt.Ids[0] || c.Ids[0] == nt.Ids[1] || c.Ids[0] == nt.Ids[2] ||
+          c.Ids[1] == nt.Ids[0] || c.Ids[1] == nt.Ids[1] || c.Ids[1] == nt.Ids[2] ||
+          c.Ids[2] == nt.Ids[0] || c.Ids[2] == nt.Ids[1] || c.Ids[2] == nt.Ids[2]);
+        // disjoint triangles whose bounding spheres are farther apart than selfDelta cannot conflict
+        if (disjoint && (c.C - nt.C).norm() - c.R - nt.R >= selfDelta)
+          continue;
+        if (trianglesConflict(nt.Ids, nt.Pts, c.Ids, c.Pts, selfDelta, FoldCosine))
+          return Verdict::Self;
+      }
     }
     return Verdict::Ok;
-  }
-
-  // Do two cage triangles conflict? Disjoint ones must keep selfDelta apart; ones sharing a vertex
-  // must not meet elsewhere; ones sharing an edge must not fold onto each other.
-  static bool pairConflict(const int ia[3], const Vec3 pa[3], const int ib[3], const Vec3 pb[3], double selfDelta)
-  {
-    int sa[3], sb[3], shared = 0;
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j)
-        if (ia[i] == ib[j])
-        {
-          sa[shared] = i;
-          sb[shared] = j;
-          ++shared;
-        }
-    if (shared == 0)
-      return triangleTriangleDistance2(pa, pb) < selfDelta * selfDelta;
-    if (shared == 1)
-    {
-      const int i = sa[0], j = sb[0];
-      return meetBeyondSharedVertex(pa[i], pa[(i + 1) % 3], pa[(i + 2) % 3], pb[(j + 1) % 3], pb[(j + 2) % 3]);
-    }
-    if (shared == 2)
-    {
-      const Vec3 na = (pa[1] - pa[0]).cross(pa[2] - pa[0]), nb = (pb[1] - pb[0]).cross(pb[2] - pb[0]);
-      // dihedral fold: the two faces turned almost onto each other
-      return na.dot(nb) < -0.95 * na.norm() * nb.norm();
-    }
-    return true; // the same triangle twice: a non-manifold configuration
   }
 
   // Gradient descent on Psi (eq. 5-6): move the placement so that the new one-ring moves away from
@@ -607,16 +611,23 @@ private:
       Grid.insert(f, lo, hi);
     }
     const std::vector<int> ring = neighbours(C0);
-    for (int n : ring)
+    for (int v : { C0, C1 })
     {
-      Blocked.erase(edgeKey(C0, n));
-      pushEdge(std::min(C0, n), std::max(C0, n));
+      for (int n : BlockedAt[v])
+        Blocked.erase(edgeKey(v, n));
+      BlockedAt[v].clear();
     }
-    // edges around the ring saw their neighbourhood change: retry the blocked ones
+    for (int n : ring)
+      pushEdge(std::min(C0, n), std::max(C0, n));
+    // edges around the ring saw their neighbourhood change: retry the blocked ones (stale
+    // partners, already collapsed or re-queued, are filtered when popped)
     for (int r : ring)
-      for (int n : neighbours(r))
-        if (n != C0 && Blocked.erase(edgeKey(r, n)))
+    {
+      for (int n : BlockedAt[r])
+        if (Blocked.erase(edgeKey(r, n)) && n != C0 && VAlive[n])
           pushEdge(std::min(r, n), std::max(r, n));
+      BlockedAt[r].clear();
+    }
   }
 
   void rebuildGrid()
@@ -660,6 +671,8 @@ private:
     int Ids[3];
     Vec3 Pts[3];
     Vec3 N;
+    Vec3 C;   // centroid
+    double R; // bounding radius about C
   };
 
   const TriangleTree& Input;
@@ -675,9 +688,19 @@ private:
   std::vector<unsigned> Seen;
   unsigned QueryId = 0;
   std::vector<NewTri> NewTris;
+  struct Candidate
+  {
+    int F;
+    int Ids[3];
+    Vec3 Pts[3];
+    Vec3 Lo, Hi, C;
+    double R;
+  };
+  std::vector<Candidate> Candidates;
   int AliveVertices = 0, AliveTriangles = 0, GridTriangles = 0;
   CageGrid Grid;
   std::priority_queue<Entry> Heap;
+  std::vector<std::vector<int>> BlockedAt;
   std::unordered_set<std::uint64_t> Blocked;
   SimplifyResult Stats;
 };

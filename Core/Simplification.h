@@ -32,6 +32,10 @@ struct SimplifyOptions
   double MinimumNormalCosine = 0.2;
   /// Gradient steps on Psi (eq. 5-6) to move an infeasible placement into the feasible region.
   int PlacementIterations = 8;
+  /// For comparisons only: turning these off gives plain (unconstrained) QEM, which does not
+  /// keep the guarantees. Link condition, flip and needle checks stay on.
+  bool EnforceClearance = true;
+  bool EnforceNoSelfIntersection = true;
 
   double selfClearance() const { return SelfClearance > 0 ? SelfClearance : Clearance / 4; }
 };
