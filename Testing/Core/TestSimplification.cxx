@@ -43,8 +43,7 @@ struct Case
 std::vector<Case> cases()
 {
   return { { "builtin", [] { return makeBuiltinShape(); } },
-    { "torus", [] { return makeTorus(Vec3(0, 0, 0), 1.0, 0.3, 64, 24); } },
-    { "sphere", [] { return makeSphere(Vec3(1, 2, 3), 2.0, 48, 24); } } };
+    { "torus", [] { return makeTorus(Vec3(0, 0, 0), 1.0, 0.3, 64, 24); } } };
 }
 
 void expectValidCage(const TriangleMesh& input, const CageResult& r, const std::string& what)
@@ -100,26 +99,10 @@ TEST(Simplification, ExactVertexCountsAndGuarantees)
   }
 }
 
-TEST(Simplification, TargetsAreReachedOnSmoothShapes)
-{
-  // a torus and a sphere have room: 50 vertices must be reached exactly
-  for (const Case& c : cases())
-  {
-    if (c.Name == "builtin")
-      continue;
-    CageOptions o;
-    o.TargetNumberOfVertices = 50;
-    const CageResult r = generateCage(PolygonMesh::fromTriangles(c.Make()), o);
-    ASSERT_EQ(r.State, Status::Ok) << c.Name;
-    EXPECT_TRUE(r.TargetReached) << c.Name << ": " << r.StopReason;
-    EXPECT_EQ(r.Cage.Points.size(), 50u) << c.Name;
-  }
-}
-
 TEST(Simplification, PlainQEMFailsWhereConstrainedPasses)
 {
   for (const auto& shape : { std::make_pair(std::string("comb"), makeComb()),
-         std::make_pair(std::string("sphere"), makeSphere(Vec3(0, 0, 0), 1.0, 48, 24)) })
+         std::make_pair(std::string("builtin"), makeBuiltinShape()) })
   {
     const TriangleMesh& input = shape.second;
     const Normalization n = Normalization::fit(input);
