@@ -2,13 +2,16 @@
 // clearance and verdict. Each mesh runs in its own process so that peak memory is per mesh.
 #include "CageGenerator.h"
 #include "MeshIO.h"
+#include "Validation.h"
 #include "Shapes.h"
+#include "TriangleTree.h"
 
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -25,10 +28,30 @@ namespace
 
 void usage()
 {
-  std::printf("usage: sdfcage_benchmark [--builtin] [--iso C] [--voxel H] [--adaptivity A] "
+  std::printf("usage: sdfcage_benchmark [--builtin] [--vertices N] [--iso C] [--voxel H] [--adaptivity A] "
               "[--threads N] [FILE|FOLDER ...]\n"
               "  default: every mesh of %s\n",
     SDFCAGE_DATA_DIR);
+}
+
+/// One-sided Hausdorff distance cage -> input, sampled: every cage triangle on a barycentric grid
+/// with spacing about `step` (plus its corners), exact point-to-mesh distances.
+double hausdorffCageToInput(const TriangleMesh& cage, const TriangleTree& input, double step)
+{
+  double worst = 0.0;
+  for (const Triangle& t : cage.Triangles)
+  {
+    const Vec3 a = cage.Points[t[0]], b = cage.Points[t[1]], c = cage.Points[t[2]];
+    const double longest = std::max({ (b - a).norm(), (c - b).norm(), (a - c).norm() });
+    const int n = std::max(1, std::min(64, static_cast<int>(std::ceil(longest / step))));
+    for (int i = 0; i <= n; ++i)
+      for (int j = 0; i + j <= n; ++j)
+      {
+        const double u = double(i) / n, v = double(j) / n;
+        worst = std::max(worst, input.distance(a + u * (b - a) + v * (c - a)));
+      }
+  }
+  return worst;
 }
 
 int runOne(const std::string& name, const std::string& path, const CageOptions& options)
@@ -43,7 +66,7 @@ int runOne(const std::string& name, const std::string& path, const CageOptions& 
   {
     std::string error;
     const auto t0 = std::chrono::steady_clock::now();
-    if (!readPolygonMesh(path, input, error))
+    if (!exact::readPolygonMesh(path, input, error))
     {
       std::printf("| %-24s | cannot read: %s |\n", name.c_str(), error.c_str());
       return 2;
@@ -57,17 +80,25 @@ int runOne(const std::string& name, const std::string& path, const CageOptions& 
   const double envelopeStage = r.ValidationSeconds + r.DistanceFieldSeconds + r.IsosurfaceSeconds + r.VerificationSeconds;
   if (r.State == Status::Ok)
   {
-    std::printf("| %-24s | %8zu | %5.2f | %6.3f | %6.3f | %6.3f | %6.3f | %6.3f | %8zu | %7.5f | %d→%d | %d | %7.0f | %s |\n",
+    // Hausdorff relative to the input's bounding-box diagonal, measured in input units
+    TriangleMesh in;
+    prepareMesh(input, in);
+    const auto box = bounds(in);
+    const double diagonal = (box[1] - box[0]).norm();
+    const TriangleTree tree(in);
+    const double hausdorff = r.Cage.empty() ? 0.0 : hausdorffCageToInput(r.Cage, tree, diagonal / 500.0) / diagonal;
+    std::printf("| %-24s | %8zu | %5.2f | %6.3f | %6.3f | %6.3f | %6.3f | **%6.3f** | %8zu | %6.3f | %6.3f | **%6.3f** | %5d | %7.5f | %7.5f | %d→%d→%d | %d | %7.0f | %s |\n",
       name.c_str(), input.numberOfCells(), readSeconds, r.ValidationSeconds, r.DistanceFieldSeconds,
       r.IsosurfaceSeconds, r.VerificationSeconds, envelopeStage, r.Envelope.Triangles.size(),
-      r.MinimumClearanceRelative, r.Defects.Genus, r.EnvelopeGenus, r.RemovedPockets, peakMB,
-      r.EnclosureVerified ? "yes" : "NO");
+      r.SimplificationSeconds, r.CageVerificationSeconds, r.TotalSeconds, r.VerticesReached,
+      r.MinimumClearanceRelative, hausdorff, r.Defects.Genus, r.EnvelopeGenus, genus(r.Cage),
+      r.RemovedPockets, peakMB, r.EnclosureVerified ? (r.TargetReached ? "yes" : "yes (target not reached)") : "NO");
   }
   else
   {
     std::string msg = r.Message.substr(0, 90);
-    std::printf("| %-24s | %8zu | %5.2f | %6.3f | — | — | — | %6.3f | — | — | — | — | %7.0f | %s: %s |\n",
-      name.c_str(), input.numberOfCells(), readSeconds, r.ValidationSeconds, envelopeStage, peakMB,
+    std::printf("| %-24s | %8zu | %5.2f | %6.3f | — | — | — | %6.3f | — | — | — | %6.3f | — | — | — | — | — | %7.0f | %s: %s |\n",
+      name.c_str(), input.numberOfCells(), readSeconds, r.ValidationSeconds, envelopeStage, r.TotalSeconds, peakMB,
       statusName(r.State), msg.c_str());
   }
   std::fflush(stdout);
@@ -98,6 +129,12 @@ int main(int argc, char** argv)
       value(options.Envelope.IsoValue);
     else if (a == "--voxel")
       value(options.Envelope.VoxelSize);
+    else if (a == "--vertices" || a == "-n")
+    {
+      double t = 0;
+      value(t);
+      options.TargetNumberOfVertices = static_cast<int>(t);
+    }
     else if (a == "--adaptivity")
       value(options.Envelope.Adaptivity);
     else if (a == "--threads")
@@ -144,11 +181,13 @@ int main(int argc, char** argv)
       return 2;
     }
   }
-  std::printf("c = %g, voxel = %g, adaptivity = %g, threads = %d (0 = all)\n\n", options.Envelope.IsoValue,
-    options.Envelope.voxelSize(), options.Envelope.Adaptivity, options.Envelope.NumberOfThreads);
+  std::printf("c = %g, voxel = %g, adaptivity = %g, target vertices = %d, threads = %d (0 = all)\n\n",
+    options.Envelope.IsoValue, options.Envelope.voxelSize(), options.Envelope.Adaptivity,
+    options.TargetNumberOfVertices, options.Envelope.NumberOfThreads);
   std::printf("| mesh | faces | read s | validate s | SDF s | isosurface s | verify s | envelope stage s | "
-              "envelope tris | clearance (unit) | genus in→env | pockets | peak MB | verified |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+              "envelope tris | simplify s | cage verify s | total s | cage verts | clearance (unit) | "
+              "Hausdorff cage→input (/diag) | genus in→env→cage | pockets | peak MB | verified |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   std::fflush(stdout);
   int failures = 0;
   for (const auto& m : meshes)
