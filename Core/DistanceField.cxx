@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <mutex>
 #include <cstdlib>
 
@@ -153,21 +154,43 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
 
   if (keepField)
   {
-    // Dense copy for display, capped at 256 samples per axis (trilinear resampling).
-    const openvdb::CoordBBox box = grid->evalActiveVoxelBoundingBox();
-    const openvdb::Vec3d lo = grid->indexToWorld(box.min());
-    const openvdb::Vec3d hi = grid->indexToWorld(box.max());
-    const double extent = std::max({ hi.x() - lo.x(), hi.y() - lo.y(), hi.z() - lo.z() });
+    // For display: a separate, coarser field (at most 256 samples per axis) over the whole box
+    // with the interior filled and a wide exterior band, so slices and contours show the real
+    // distances rather than the narrow band the envelope needs.
+    const auto box = bounds(unitInput);
+    const double extent = (box[1] - box[0]).maxCoeff() + 4.0 * iso;
     const double spacing = std::max(voxelSize, extent / 255.0);
+    std::vector<openvdb::Vec3s> coarsePoints(unitInput.Points.size());
+    for (std::size_t i = 0; i < coarsePoints.size(); ++i)
+    {
+      const Vec3 p = unitInput.Points[i] / spacing;
+      coarsePoints[i] = openvdb::Vec3s(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
+    }
+    openvdb::tools::QuadAndTriangleDataAdapter<openvdb::Vec3s, openvdb::Vec3I> coarseAdapter(coarsePoints, tris);
+    auto coarseTransform = openvdb::math::Transform::createLinearTransform(spacing);
+    const float band = static_cast<float>(std::ceil(2.0 * iso / spacing) + 8.0);
+    openvdb::FloatGrid::Ptr field;
+    try
+    {
+      field = openvdb::tools::meshToVolume<openvdb::FloatGrid>(
+        coarseAdapter, *coarseTransform, band, std::numeric_limits<float>::max(), 0);
+    }
+    catch (const std::exception& e)
+    {
+      out.Error = std::string("OpenVDB could not compute the display field: ") + e.what();
+      return out;
+    }
     ScalarImage& img = out.Field;
     img.Spacing = spacing;
-    img.Origin = Vec3(lo.x(), lo.y(), lo.z());
+    const Vec3 lo = box[0] - Vec3::Constant(2.0 * iso + 2.0 * spacing);
+    const Vec3 hi = box[1] + Vec3::Constant(2.0 * iso + 2.0 * spacing);
+    img.Origin = lo;
     for (int a = 0; a < 3; ++a)
     {
       img.Dimensions[a] = static_cast<int>(std::floor((hi[a] - lo[a]) / spacing)) + 1;
     }
     img.Values.resize(static_cast<std::size_t>(img.Dimensions[0]) * img.Dimensions[1] * img.Dimensions[2]);
-    openvdb::tools::GridSampler<openvdb::FloatGrid, openvdb::tools::BoxSampler> sampler(*grid);
+    openvdb::tools::GridSampler<openvdb::FloatGrid, openvdb::tools::BoxSampler> sampler(*field);
     std::size_t n = 0;
     for (int k = 0; k < img.Dimensions[2]; ++k)
       for (int j = 0; j < img.Dimensions[1]; ++j)

@@ -17,7 +17,7 @@ struct IsosurfaceOutput
 {
   /// the isosurface {xi = iso} for each requested adaptivity, triangles (quads split), unit units
   std::vector<TriangleMesh> Surfaces;
-  ScalarImage Field;      ///< dense samples of xi, when requested
+  ScalarImage Field;      ///< for display: xi on a coarser grid (<= 256 per axis), interior filled
   bool Cancelled = false;
   std::string Error;
   double DistanceFieldSeconds = 0.0;

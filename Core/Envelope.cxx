@@ -135,6 +135,9 @@ long long countSelfIntersections(const TriangleMesh& mesh, Progress* progress)
   const std::size_t nf = mesh.Triangles.size();
   // exact-intersection fold test for edge-sharing pairs: only exactly opposite normals overlap
   const double foldCosine = -1.0 + 1e-12;
+  // disjoint triangles closer than this (relative to the mesh size) count as touching
+  const auto box = bounds(mesh);
+  const double touching = 1e-12 * std::max(1.0, (box[1] - box[0]).norm());
   return tbb::parallel_reduce(
     tbb::blocked_range<std::size_t>(0, nf, 2048), 0LL,
     [&](const tbb::blocked_range<std::size_t>& r, long long count) {
@@ -157,7 +160,7 @@ long long countSelfIntersections(const TriangleMesh& mesh, Progress* progress)
           const Triangle& o = mesh.Triangles[g];
           const int ib[3] = { o[0], o[1], o[2] };
           const Vec3 pb[3] = { mesh.Points[o[0]], mesh.Points[o[1]], mesh.Points[o[2]] };
-          count += trianglesConflict(ia, pa, ib, pb, 0.0, foldCosine);
+          count += trianglesConflict(ia, pa, ib, pb, touching, foldCosine);
         });
       }
       return count;

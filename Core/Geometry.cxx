@@ -117,9 +117,16 @@ bool segmentTriangleIntersect(const Vec3& p, const Vec3& q, const Vec3& a, const
     return (y - x).cross(z - x).dot(w - x);
   };
   const double sp = orient(a, b, c, p), sq = orient(a, b, c, q);
-  if ((sp > 0 && sq > 0) || (sp < 0 && sq < 0) || (sp == 0 && sq == 0))
+  if ((sp > 0 && sq > 0) || (sp < 0 && sq < 0))
   {
-    return false; // coplanar case is covered by the edge-edge distances
+    return false;
+  }
+  // An endpoint on (or within rounding of) the plane makes the crossing test ill-conditioned; the
+  // point-triangle and edge-edge distances of the caller decide those cases exactly enough.
+  const double scale = (b - a).cross(c - a).norm() * (q - p).norm();
+  if (std::abs(sp) <= 1e-10 * scale || std::abs(sq) <= 1e-10 * scale)
+  {
+    return false;
   }
   const double s1 = orient(p, q, a, b), s2 = orient(p, q, b, c), s3 = orient(p, q, c, a);
   return (s1 >= 0 && s2 >= 0 && s3 >= 0) || (s1 <= 0 && s2 <= 0 && s3 <= 0);
