@@ -7,6 +7,7 @@
 #include "Shapes.h"
 #include "TriangleIndex.h"
 
+#include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -199,6 +200,51 @@ TEST(Geometry, TriangleDistanceMatchesSamplingAndCgal)
     EXPECT_LE(d, best + 1e-12) << "trial " << trial;
     EXPECT_GE(d, best - h) << "trial " << trial;
   }
+}
+
+TEST(Geometry, CoplanarTriangleDistance)
+{
+  // Dense envelopes are full of coplanar triangles (grid-aligned marching-cubes facets), so
+  // disjoint coplanar pairs must get their true distance, not 0.
+  auto check = [](const Vec3 a[3], const Vec3 b[3], const char* what) {
+    TriangleMesh ta, tb;
+    ta.Points = { a[0], a[1], a[2] };
+    ta.Triangles = { { 0, 1, 2 } };
+    tb.Points = { b[0], b[1], b[2] };
+    tb.Triangles = { { 0, 1, 2 } };
+    const exact::ExactReport r = exact::exactCheck(ta, tb, 10.0);
+    const double d = std::sqrt(triangleTriangleDistance2(a, b));
+    EXPECT_NEAR(d, r.MinimumClearance, 1e-12) << what;
+    return r.MinimumClearance;
+  };
+  const Vec3 a[3] = { Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0) };
+  const Vec3 apart[3] = { Vec3(2, 0, 0), Vec3(3, 0, 0), Vec3(2, 1, 0) };
+  EXPECT_NEAR(check(a, apart, "z = 0, one apart"), 1.0, 1e-12);
+  const Vec3 overlapping[3] = { Vec3(0.2, 0.2, 0), Vec3(2, 0.2, 0), Vec3(0.2, 2, 0) };
+  EXPECT_EQ(check(a, overlapping, "z = 0, overlapping"), 0.0);
+  const Vec3 touching[3] = { Vec3(1, 0, 0), Vec3(2, 0, 0), Vec3(2, 1, 0) };
+  EXPECT_EQ(check(a, touching, "z = 0, touching at a corner"), 0.0);
+
+  // The same pairs in a tilted plane.
+  const Eigen::Matrix3d rotation =
+    (Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()) * Eigen::AngleAxisd(0.3, Vec3::UnitX()))
+      .toRotationMatrix();
+  Vec3 ra[3], rb[3];
+  for (int k = 0; k < 3; ++k)
+  {
+    ra[k] = rotation * a[k] + Vec3(0.5, -2, 7);
+    rb[k] = rotation * apart[k] + Vec3(0.5, -2, 7);
+  }
+  EXPECT_NEAR(check(ra, rb, "tilted, one apart"), 1.0, 1e-12);
+
+  // A pair from a marching-cubes envelope of a torus (coordinates as produced), 0.0037 apart.
+  const Vec3 ea[3] = { Vec3(-0.9837767481803894, -0.072499997913837433, -0.10249999910593033),
+    Vec3(-0.98170572519302368, -0.072499997913837433, -0.10750000178813934),
+    Vec3(-0.98353111743927002, -0.077500000596046448, -0.10249999910593033) };
+  const Vec3 eb[3] = { Vec3(-0.98328548669815063, -0.082500003278255463, -0.10249999910593033),
+    Vec3(-0.9814600944519043, -0.077500000596046448, -0.10750000178813934),
+    Vec3(-0.98121446371078491, -0.082500003278255463, -0.10750000178813934) };
+  EXPECT_GT(check(ea, eb, "envelope facets"), 0.003);
 }
 
 TEST(Geometry, WindingNumberInsideOutside)

@@ -9,6 +9,7 @@
 // count or a stop reason. --expect=invalid: the mesh is not watertight; the run must end
 // with InvalidInput and a message naming the boundary edges. --inward: the mesh faces inward and
 // validation must flip it.
+#include "../Core/CoreTestPrinters.h"
 #include "CageGenerator.h"
 #include "ExactCheck.h"
 #include "MeshIO.h"
