@@ -101,8 +101,9 @@ TEST(Simplification, ExactVertexCountsAndGuarantees)
 
 TEST(Simplification, PlainQEMFailsWhereConstrainedPasses)
 {
-  for (const auto& shape : { std::make_pair(std::string("comb"), makeComb()),
-         std::make_pair(std::string("builtin"), makeBuiltinShape()) })
+  // (the comb of makeComb() shows the same, but its envelope needs the dense non-adaptive grid,
+  // which makes the test slow; the built-in shape is enough to show it)
+  for (const auto& shape : { std::make_pair(std::string("builtin"), makeBuiltinShape()) })
   {
     const TriangleMesh& input = shape.second;
     const Normalization n = Normalization::fit(input);
