@@ -19,6 +19,17 @@ double seconds(std::chrono::steady_clock::time_point t0)
 }
 } // namespace
 
+ScalarImage imageToInput(ScalarImage image, const Normalization& n)
+{
+  image.Origin = n.toInput(image.Origin);
+  image.Spacing = n.lengthToInput(image.Spacing);
+  for (float& v : image.Values)
+  {
+    v = static_cast<float>(n.lengthToInput(v));
+  }
+  return image;
+}
+
 CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Progress* progress)
 {
   CageResult result;
@@ -72,6 +83,12 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
   result.VerificationSeconds = env.VerificationSeconds;
   result.VoxelSizeUsed = env.VoxelSizeUsed;
   result.RemovedPockets = env.RemovedPockets;
+  result.InputGenus = env.InputGenus;
+  result.InputComponents = env.InputComponents;
+  result.NumberOfActivePoints = env.NumberOfActivePoints;
+  result.NumberOfActiveSamples = env.NumberOfActiveSamples;
+  result.ActivePointSeconds = env.ActivePointSeconds;
+  result.TopologyWarning = env.TopologyWarning;
   result.TotalSeconds = seconds(start);
   if (env.State != Status::Ok)
   {
@@ -92,13 +109,8 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
   }
   if (options.Envelope.KeepDistanceField)
   {
-    result.DistanceField = std::move(env.DistanceField);
-    result.DistanceField.Origin = n.toInput(result.DistanceField.Origin);
-    result.DistanceField.Spacing = n.lengthToInput(result.DistanceField.Spacing);
-    for (float& v : result.DistanceField.Values)
-    {
-      v = static_cast<float>(n.lengthToInput(v));
-    }
+    result.DistanceField = imageToInput(env.DistanceField, n);
+    result.ModifiedDistanceField = imageToInput(env.ModifiedDistanceField, n);
   }
 
   // 4. the cage: constrained simplification of the verified envelope, verified again

@@ -35,6 +35,14 @@ struct CageResult
   int EnvelopeGenus = 0;
   int EnvelopeComponents = 0;
   double VoxelSizeUsed = 0.0;       ///< unit-sphere units
+  int InputGenus = 0;
+  int InputComponents = 0;
+  std::size_t NumberOfActivePoints = 0;  ///< input points flagged active (0 when off)
+  std::size_t NumberOfActiveSamples = 0; ///< the active set A on the surface sampling
+  double ActivePointSeconds = 0.0;
+  /// Non-empty when the envelope (and so the cage) does not have the input's genus and
+  /// component count: parts closer than the parameters can separate were fused.
+  std::string TopologyWarning;
   double ValidationSeconds = 0.0;
   double DistanceFieldSeconds = 0.0;
   double IsosurfaceSeconds = 0.0;
@@ -47,8 +55,12 @@ struct CageResult
   double CageVerificationSeconds = 0.0;
   double TotalSeconds = 0.0;
   ScalarImage DistanceField;        ///< input coordinates and units, when requested
+  ScalarImage ModifiedDistanceField; ///< phi * xi, input units, when requested and active points exist
   Normalization Normalize;
 };
+
+/// A field sampled in unit-sphere units, mapped back to input coordinates and lengths.
+ScalarImage imageToInput(ScalarImage image, const Normalization& n);
 
 CageResult generateCage(const PolygonMesh& input, const CageOptions& options,
   Progress* progress = nullptr);

@@ -1,11 +1,16 @@
 #include "DistanceField.h"
 
+#include "ActivePoints.h"
+#include "Geometry.h"
 #include "Progress.h"
 
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/MeshToVolume.h>
 #include <openvdb/tools/VolumeToMesh.h>
+#include <openvdb/tree/LeafManager.h>
+
+#include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
@@ -55,26 +60,182 @@ double seconds(std::chrono::steady_clock::time_point t0)
 
 std::once_flag vdbInit;
 
+/// phi at world position x (unit-sphere units) given the closest triangle of amp.Surface.
+double phiAt(const ActivePoints& amp, const Vec3& x, int triangle, double distance)
+{
+  const Triangle& t = amp.Surface.Triangles[triangle];
+  const Vec3 closest = closestPointOnTriangle(
+    x, amp.Surface.Points[t[0]], amp.Surface.Points[t[1]], amp.Surface.Points[t[2]]);
+  return amp.amplificationAt(triangle, closest, distance);
+}
+
+/// xi -> phi * xi on the active voxels outside the input (values in (0, maxValue]); returns the
+/// number of voxels changed by more than 1e-3 relative.
+std::size_t amplify(openvdb::FloatGrid& grid, const openvdb::Int32Grid& index, const ActivePoints& amp,
+  double voxelSize, float maxValue)
+{
+  openvdb::tree::LeafManager<openvdb::FloatTree> leaves(grid.tree());
+  std::atomic<std::size_t> changed{ 0 };
+  const int triangles = static_cast<int>(amp.Surface.Triangles.size());
+  tbb::parallel_for(leaves.leafRange(), [&](const openvdb::tree::LeafManager<openvdb::FloatTree>::LeafRange& range) {
+    auto acc = index.getConstAccessor();
+    std::size_t local = 0;
+    for (auto leaf = range.begin(); leaf; ++leaf)
+    {
+      for (auto it = leaf->beginValueOn(); it; ++it)
+      {
+        const float v = *it;
+        if (!(v > 0.0f) || v > maxValue)
+        {
+          continue;
+        }
+        const openvdb::Coord ijk = it.getCoord();
+        const int t = acc.getValue(ijk);
+        if (t < 0 || t >= triangles)
+        {
+          continue;
+        }
+        const Vec3 x(ijk.x() * voxelSize, ijk.y() * voxelSize, ijk.z() * voxelSize);
+        const double phi = phiAt(amp, x, t, v);
+        if (phi > 1.001)
+        {
+          ++local;
+        }
+        it.setValue(static_cast<float>(phi * v));
+      }
+    }
+    changed += local;
+  });
+  return changed.load();
+}
+
 } // namespace
 
-IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSize, double iso,
-  bool keepField, Progress* progress, const std::vector<double>& adaptivities)
+bool computeDisplayFields(const TriangleMesh& unitMesh, double iso, double minSpacing,
+  const ActivePoints* amplification, ScalarImage& field, ScalarImage* modified, std::string& error)
 {
   std::call_once(vdbInit, []() { openvdb::initialize(); });
+  if (amplification && amplification->empty())
+  {
+    amplification = nullptr;
+  }
+  const double voxelSize = minSpacing;
+  std::vector<openvdb::Vec3I> tris(unitMesh.Triangles.size());
+  for (std::size_t f = 0; f < tris.size(); ++f)
+  {
+    const Triangle& t = unitMesh.Triangles[f];
+    tris[f] = openvdb::Vec3I(t[0], t[1], t[2]);
+  }
+
+  // For display: a separate, coarser field (at most 256 samples per axis) over the whole box
+  // with the interior filled and a wide exterior band, so slices and contours show the real
+  // distances rather than the narrow band the envelope needs.
+  const auto box = bounds(unitMesh);
+  const double extent = (box[1] - box[0]).maxCoeff() + 4.0 * iso;
+  const double spacing = std::max(voxelSize, extent / 255.0);
+  std::vector<openvdb::Vec3s> coarsePoints(unitMesh.Points.size());
+  for (std::size_t i = 0; i < coarsePoints.size(); ++i)
+  {
+    const Vec3 p = unitMesh.Points[i] / spacing;
+    coarsePoints[i] = openvdb::Vec3s(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
+  }
+  openvdb::tools::QuadAndTriangleDataAdapter<openvdb::Vec3s, openvdb::Vec3I> coarseAdapter(coarsePoints, tris);
+  auto coarseTransform = openvdb::math::Transform::createLinearTransform(spacing);
+  // With amplification the exterior band also covers where phi differs from 1 noticeably
+  // (phi - 1 < 2e-4 (alpha - 1) beyond 0.36 at beta = 8), and closest triangles are kept.
+  double bandWorld = 2.0 * iso + 8.0 * spacing;
+  openvdb::Int32Grid::Ptr displayTriangle;
+  if (amplification)
+  {
+    bandWorld = std::max(bandWorld, std::min(amplification->Cutoff, 3.0 / amplification->Beta));
+    displayTriangle = openvdb::Int32Grid::create(-1);
+  }
+  const float band = static_cast<float>(std::ceil(bandWorld / spacing) + 1.0);
+  openvdb::FloatGrid::Ptr grid;
+  try
+  {
+    openvdb::util::NullInterrupter none;
+    grid = openvdb::tools::meshToVolume<openvdb::FloatGrid>(none, coarseAdapter, *coarseTransform,
+      band, std::numeric_limits<float>::max(), 0, displayTriangle.get());
+  }
+  catch (const std::exception& e)
+  {
+    error = std::string("OpenVDB could not compute the display field: ") + e.what();
+    return false;
+  }
+  ScalarImage& img = field;
+  img.Spacing = spacing;
+  // samples on the voxel centres of the display grid (no interpolation)
+  openvdb::Coord first, last;
+  for (int a = 0; a < 3; ++a)
+  {
+    first[a] = static_cast<int>(std::floor((box[0][a] - 2.0 * iso) / spacing)) - 2;
+    last[a] = static_cast<int>(std::ceil((box[1][a] + 2.0 * iso) / spacing)) + 2;
+    img.Dimensions[a] = last[a] - first[a] + 1;
+  }
+  img.Origin = Vec3(first.x(), first.y(), first.z()) * spacing;
+  const std::size_t count = static_cast<std::size_t>(img.Dimensions[0]) * img.Dimensions[1] * img.Dimensions[2];
+  img.Values.resize(count);
+  if (modified)
+  {
+    *modified = img;
+    modified->Values.resize(count);
+  }
+  const int nx = img.Dimensions[0], ny = img.Dimensions[1];
+  const int triangles = static_cast<int>(unitMesh.Triangles.size());
+  tbb::parallel_for(0, img.Dimensions[2], [&](int k) {
+    auto acc = grid->getConstAccessor();
+    std::unique_ptr<openvdb::Int32Grid::ConstAccessor> tri;
+    if (displayTriangle)
+    {
+      tri = std::make_unique<openvdb::Int32Grid::ConstAccessor>(displayTriangle->getConstAccessor());
+    }
+    std::size_t n = static_cast<std::size_t>(k) * nx * ny;
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i, ++n)
+      {
+        const openvdb::Coord ijk(first.x() + i, first.y() + j, first.z() + k);
+        const float v = acc.getValue(ijk);
+        img.Values[n] = v;
+        if (tri && modified)
+        {
+          const int t = tri->getValue(ijk);
+          double phi = 1.0;
+          if (t >= 0 && t < triangles)
+          {
+            phi = phiAt(*amplification, Vec3(ijk.x(), ijk.y(), ijk.z()) * spacing, t, std::abs(v));
+          }
+          modified->Values[n] = static_cast<float>(phi * v);
+        }
+      }
+  });
+  return true;
+}
+
+IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSize, double iso,
+  bool keepField, Progress* progress, const std::vector<double>& adaptivities,
+  const ActivePoints* amplification)
+{
+  std::call_once(vdbInit, []() { openvdb::initialize(); });
+  if (amplification && amplification->empty())
+  {
+    amplification = nullptr; // no active point: phi = 1 everywhere
+  }
+  const TriangleMesh& unitMesh = amplification ? amplification->Surface : unitInput;
   IsosurfaceOutput out;
   auto t0 = std::chrono::steady_clock::now();
 
   // mesh in index space (voxel centres at integer coordinates)
-  std::vector<openvdb::Vec3s> points(unitInput.Points.size());
+  std::vector<openvdb::Vec3s> points(unitMesh.Points.size());
   for (std::size_t i = 0; i < points.size(); ++i)
   {
-    const Vec3 p = unitInput.Points[i] / voxelSize;
+    const Vec3 p = unitMesh.Points[i] / voxelSize;
     points[i] = openvdb::Vec3s(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
   }
-  std::vector<openvdb::Vec3I> tris(unitInput.Triangles.size());
+  std::vector<openvdb::Vec3I> tris(unitMesh.Triangles.size());
   for (std::size_t f = 0; f < tris.size(); ++f)
   {
-    const Triangle& t = unitInput.Triangles[f];
+    const Triangle& t = unitMesh.Triangles[f];
     tris[f] = openvdb::Vec3I(t[0], t[1], t[2]);
   }
   openvdb::tools::QuadAndTriangleDataAdapter<openvdb::Vec3s, openvdb::Vec3I> adapter(points, tris);
@@ -88,10 +249,15 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
   const float interiorBand = 1.0f;
   VdbInterrupter sdfInterrupter(progress, 0.0, 0.6);
   openvdb::FloatGrid::Ptr grid;
+  openvdb::Int32Grid::Ptr closestTriangle;
+  if (amplification)
+  {
+    closestTriangle = openvdb::Int32Grid::create(-1);
+  }
   try
   {
     grid = openvdb::tools::meshToVolume<openvdb::FloatGrid>(
-      sdfInterrupter, adapter, *transform, exteriorBand, interiorBand, 0);
+      sdfInterrupter, adapter, *transform, exteriorBand, interiorBand, 0, closestTriangle.get());
   }
   catch (const std::exception& e)
   {
@@ -105,6 +271,14 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
     return out;
   }
   out.ActiveVoxels = grid->activeVoxelCount();
+  if (amplification)
+  {
+    // xi^ = phi xi (eq. 2–3) wherever the isosurface xi^ = iso can lie or be interpolated from:
+    // phi >= 1, so only where xi <= iso (plus a voxel for the interpolation).
+    out.AmplifiedVoxels = amplify(*grid, *closestTriangle, *amplification, voxelSize,
+      static_cast<float>(iso + 2.0 * voxelSize));
+    closestTriangle.reset();
+  }
 
   auto t1 = std::chrono::steady_clock::now();
   for (const double adaptivity : adaptivities)
@@ -152,52 +326,11 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
   }
   progressUpdate(progress, 0.9);
 
-  if (keepField)
+  if (keepField &&
+    !computeDisplayFields(unitMesh, iso, voxelSize, amplification, out.Field,
+      amplification ? &out.ModifiedField : nullptr, out.Error))
   {
-    // For display: a separate, coarser field (at most 256 samples per axis) over the whole box
-    // with the interior filled and a wide exterior band, so slices and contours show the real
-    // distances rather than the narrow band the envelope needs.
-    const auto box = bounds(unitInput);
-    const double extent = (box[1] - box[0]).maxCoeff() + 4.0 * iso;
-    const double spacing = std::max(voxelSize, extent / 255.0);
-    std::vector<openvdb::Vec3s> coarsePoints(unitInput.Points.size());
-    for (std::size_t i = 0; i < coarsePoints.size(); ++i)
-    {
-      const Vec3 p = unitInput.Points[i] / spacing;
-      coarsePoints[i] = openvdb::Vec3s(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
-    }
-    openvdb::tools::QuadAndTriangleDataAdapter<openvdb::Vec3s, openvdb::Vec3I> coarseAdapter(coarsePoints, tris);
-    auto coarseTransform = openvdb::math::Transform::createLinearTransform(spacing);
-    const float band = static_cast<float>(std::ceil(2.0 * iso / spacing) + 8.0);
-    openvdb::FloatGrid::Ptr field;
-    try
-    {
-      field = openvdb::tools::meshToVolume<openvdb::FloatGrid>(
-        coarseAdapter, *coarseTransform, band, std::numeric_limits<float>::max(), 0);
-    }
-    catch (const std::exception& e)
-    {
-      out.Error = std::string("OpenVDB could not compute the display field: ") + e.what();
-      return out;
-    }
-    ScalarImage& img = out.Field;
-    img.Spacing = spacing;
-    const Vec3 lo = box[0] - Vec3::Constant(2.0 * iso + 2.0 * spacing);
-    const Vec3 hi = box[1] + Vec3::Constant(2.0 * iso + 2.0 * spacing);
-    img.Origin = lo;
-    for (int a = 0; a < 3; ++a)
-    {
-      img.Dimensions[a] = static_cast<int>(std::floor((hi[a] - lo[a]) / spacing)) + 1;
-    }
-    img.Values.resize(static_cast<std::size_t>(img.Dimensions[0]) * img.Dimensions[1] * img.Dimensions[2]);
-    openvdb::tools::GridSampler<openvdb::FloatGrid, openvdb::tools::BoxSampler> sampler(*field);
-    std::size_t n = 0;
-    for (int k = 0; k < img.Dimensions[2]; ++k)
-      for (int j = 0; j < img.Dimensions[1]; ++j)
-        for (int i = 0; i < img.Dimensions[0]; ++i)
-        {
-          img.Values[n++] = sampler.wsSample(openvdb::Vec3d(lo.x() + i * spacing, lo.y() + j * spacing, lo.z() + k * spacing));
-        }
+    return out;
   }
   out.IsosurfaceSeconds = seconds(t1);
   progressUpdate(progress, 1.0);

@@ -12,23 +12,38 @@ namespace sdfcage
 {
 
 class Progress;
+struct ActivePoints;
 
 struct IsosurfaceOutput
 {
   /// the isosurface {xi = iso} for each requested adaptivity, triangles (quads split), unit units
   std::vector<TriangleMesh> Surfaces;
   ScalarImage Field;      ///< for display: xi on a coarser grid (<= 256 per axis), interior filled
+  ScalarImage ModifiedField; ///< with amplification and keepField: phi * xi on the same grid
   bool Cancelled = false;
   std::string Error;
   double DistanceFieldSeconds = 0.0;
   double IsosurfaceSeconds = 0.0;
   std::size_t ActiveVoxels = 0;
+  std::size_t AmplifiedVoxels = 0; ///< voxels whose value phi changed by more than 1e-3
 };
 
 /// Narrow-band SDF of a closed (possibly self-intersecting) mesh with OpenVDB (sign by flood
 /// fill), wide enough outside for `iso`, then marching-cubes-style extraction at `iso`.
 /// Progress: fractions 0..0.6 for the SDF, 0.6..1 for the surface of the current stage.
+/// With `amplification`, the field is the amplified xi^ = phi * xi of paper eq. 2–3 (outside the
+/// input; inside, xi is kept: its sign is all the isosurface at iso > 0 needs) and the distance
+/// field is computed on amplification->Surface (the refined input, same shape), whose triangles
+/// the closest-triangle ids refer to; `unitInput` is then unused.
 IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSize, double iso,
-  bool keepField, Progress* progress, const std::vector<double>& adaptivities = { 0.0 });
+  bool keepField, Progress* progress, const std::vector<double>& adaptivities = { 0.0 },
+  const ActivePoints* amplification = nullptr);
+
+/// For display: xi sampled on a regular grid over the mesh's box plus a margin (spacing at least
+/// `minSpacing`, at most ~256 samples per axis), interior filled, exterior band wide enough to
+/// show the amplification. With `amplification` (non-empty) and `modified`, also phi * xi on the
+/// same grid (amplification->Surface is then the mesh). False with `error` on failure.
+bool computeDisplayFields(const TriangleMesh& unitMesh, double iso, double minSpacing,
+  const ActivePoints* amplification, ScalarImage& field, ScalarImage* modified, std::string& error);
 
 } // namespace sdfcage

@@ -12,6 +12,8 @@
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -356,6 +358,36 @@ EnvelopeResult buildEnvelope(
     result.Message = "invalid parameters: need IsoValue > 0, VoxelSize > 0 and 0 < MinimumClearance < IsoValue";
     return result;
   }
+  {
+    std::vector<int> comp;
+    result.InputComponents = triangleComponents(unitInput, comp);
+    result.InputGenus = genus(unitInput);
+  }
+  ActivePoints active;
+  const ActivePoints* amplification = nullptr;
+  if (options.UseActivePoints)
+  {
+    const std::string bad = options.ActivePoints.validate();
+    if (!bad.empty())
+    {
+      result.State = Status::InvalidInput;
+      result.Message = "invalid active-point parameters: " + bad;
+      return result;
+    }
+    progressStage(progress, "active points", 0.02, 0.12 * progressEnd);
+    active = computeActivePoints(unitInput, options.ActivePoints, progress);
+    result.ActivePointSeconds = active.Seconds;
+    if (active.Cancelled || progressCancelled(progress))
+    {
+      result.State = Status::Cancelled;
+      result.Message = "cancelled";
+      return result;
+    }
+    result.NumberOfActivePoints = active.NumberOfActiveInputPoints;
+    result.NumberOfActiveSamples = active.NumberOfActiveSamples;
+    amplification = &active;
+  }
+  const double fieldBegin = options.UseActivePoints ? 0.12 * progressEnd : 0.02;
   // Attempts: the requested grid, first with the requested adaptivity and, if that envelope fails
   // verification (merged polygons can cut corners or cross), without it from the same field; then
   // finer grids without adaptivity.
@@ -368,8 +400,10 @@ EnvelopeResult buildEnvelope(
     {
       adaptivities = { options.Adaptivity, 0.0 };
     }
-    progressStage(progress, "distance field and isosurface", 0.02, 0.7 * progressEnd);
-    IsosurfaceOutput iso = computeIsosurface(unitInput, h, c, options.KeepDistanceField, progress, adaptivities);
+    progressStage(progress, "distance field and isosurface", fieldBegin, 0.7 * progressEnd);
+    IsosurfaceOutput iso =
+      computeIsosurface(unitInput, h, c, options.KeepDistanceField, progress, adaptivities, amplification);
+    result.AmplifiedVoxels = iso.AmplifiedVoxels;
     result.DistanceFieldSeconds += iso.DistanceFieldSeconds;
     result.IsosurfaceSeconds += iso.IsosurfaceSeconds;
     if (iso.Cancelled)
@@ -385,6 +419,7 @@ EnvelopeResult buildEnvelope(
       return result;
     }
     result.DistanceField = std::move(iso.Field);
+    result.ModifiedDistanceField = std::move(iso.ModifiedField);
     for (std::size_t k = 0; k < iso.Surfaces.size(); ++k, ++attempt)
     {
       auto t0 = std::chrono::steady_clock::now();
@@ -411,6 +446,23 @@ EnvelopeResult buildEnvelope(
         std::vector<int> comp;
         result.Components = triangleComponents(result.Envelope, comp);
         result.Genus = genus(result.Envelope);
+        if (result.Genus != result.InputGenus || result.Components != result.InputComponents)
+        {
+          std::ostringstream w;
+          w << "the envelope has genus " << result.Genus << " and " << result.Components
+            << " component(s), the input genus " << result.InputGenus << " and "
+            << result.InputComponents << ": parts of the input closer than the parameters can "
+            << "separate were fused";
+          if (!options.UseActivePoints)
+          {
+            w << " (active points are off: turn them on)";
+          }
+          else
+          {
+            w << " (try a smaller IsoValue and VoxelSize, or a larger ActiveRadius / AmplificationAlpha)";
+          }
+          result.TopologyWarning = w.str();
+        }
         result.EnclosureVerified = true;
         result.State = Status::Ok;
         result.Message.clear();
@@ -420,6 +472,10 @@ EnvelopeResult buildEnvelope(
       s << "envelope at voxel size " << h << " (adaptivity " << adaptivities[k]
         << ") failed verification: " << why;
       result.Message = s.str();
+      if (std::getenv("SDFCAGE_DEBUG_ENVELOPE"))
+      {
+        std::fprintf(stderr, "%s\n", result.Message.c_str());
+      }
     }
   }
   result.State = Status::VerificationFailed;

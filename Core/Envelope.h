@@ -1,6 +1,7 @@
 // SDFCage — Core: the verified SDF envelope (paper §3.1, without active points yet).
 #pragma once
 
+#include "ActivePoints.h"
 #include "Mesh.h"
 
 #include <array>
@@ -33,6 +34,11 @@ struct EnvelopeOptions
   /// Measure the envelope's exact minimum clearance (costly on a dense envelope) instead of
   /// certifying that it is at least the clearance (a certified lower bound is reported then).
   bool ExactEnvelopeClearance = false;
+  /// Shape-aware envelope (paper §3.1): detect active points (parts of the surface that nearly
+  /// touch other parts) and extract the envelope from the amplified field phi * xi, which lies
+  /// closer to the input there (down to c / alpha) so that nearly touching parts stay separate.
+  bool UseActivePoints = true;
+  ActivePointOptions ActivePoints;
   /// Keep the sampled SDF as a dense image (for display).
   bool KeepDistanceField = false;
   /// Worker threads (0 = all cores).
@@ -81,6 +87,17 @@ struct EnvelopeResult
   double IsosurfaceSeconds = 0.0;
   double VerificationSeconds = 0.0;
   ScalarImage DistanceField;        ///< filled when KeepDistanceField (unit-sphere units)
+  ScalarImage ModifiedDistanceField; ///< phi * xi, filled when KeepDistanceField and active points exist
+  std::size_t NumberOfActivePoints = 0;  ///< input points flagged active
+  std::size_t NumberOfActiveSamples = 0; ///< size of the active set A (samples)
+  std::size_t AmplifiedVoxels = 0;       ///< voxels where phi > 1.001
+  double ActivePointSeconds = 0.0;   ///< active points + g_A
+  int InputGenus = 0;
+  int InputComponents = 0;
+  /// Non-empty when the envelope's genus or component count differs from the input's (parts
+  /// closer than the parameters can separate were fused, or handles closed): the envelope is
+  /// still verified, but the cage will not have the input's topology.
+  std::string TopologyWarning;
 };
 
 /// Builds and verifies the envelope of a validated, normalized mesh (unit-sphere units).

@@ -26,6 +26,7 @@
 #include "vtkStringArray.h"
 
 #include "CageGenerator.h"
+#include "SDFCageVTKConversion.h"
 #include "Progress.h"
 
 #include <algorithm>
@@ -37,240 +38,8 @@
 
 vtkStandardNewMacro(vtkSDFCageFilter);
 
-namespace
-{
-//------------------------------------------------------------------------------
-// Forwards Core's progress to the filter, and the filter's abort flag to Core.
-// Core may call report()/pollCancel() from worker threads; VTK objects are only touched from the
-// thread that runs RequestData (the one that constructed this object). Cancellation still reaches
-// the workers: Progress latches the flag in an atomic once pollCancel() has returned true.
-class FilterProgress final : public sdfcage::Progress
-{
-public:
-  explicit FilterProgress(vtkSDFCageFilter* filter)
-    : Filter(filter)
-    , Owner(std::this_thread::get_id())
-  {
-  }
+using namespace sdfcage_vtk;
 
-protected:
-  void report(double overall, const std::string& stage) override
-  {
-    if (std::this_thread::get_id() != this->Owner)
-    {
-      return;
-    }
-    // Throttle: a new stage always shows; inside a stage, report every 1% at most (each
-    // UpdateProgress fires observers, which in ParaView repaint a progress bar).
-    const bool newStage = stage != this->LastStage;
-    if (!newStage && overall < this->LastReported + 0.01)
-    {
-      return;
-    }
-    if (newStage)
-    {
-      this->LastStage = stage;
-      this->Filter->SetProgressText(stage.c_str());
-    }
-    this->LastReported = overall;
-    this->Filter->UpdateProgress(overall);
-  }
-
-  bool pollCancel() override
-  {
-    return std::this_thread::get_id() == this->Owner && this->Filter->GetAbortExecute() != 0;
-  }
-
-private:
-  vtkSDFCageFilter* Filter;
-  std::thread::id Owner;
-  std::string LastStage;
-  double LastReported = -1.0;
-};
-
-//------------------------------------------------------------------------------
-// Appends the cells of `cells` to `mesh`. Polygons are copied as they are (Core triangulates
-// them and reports what it could not split). Triangle strips are split here; the degenerate
-// triangles a strip uses to turn (two equal ids) are an artifact of the encoding, not of the
-// surface, and are skipped. Vertex and line cells are passed as 1- and 2-point cells so that
-// Core counts them as ignored cells.
-enum class CellKind
-{
-  Vertex,
-  Line,
-  Polygon,
-  Strip
-};
-
-void AppendCells(vtkCellArray* cells, CellKind kind, sdfcage::PolygonMesh& mesh)
-{
-  if (!cells || cells->GetNumberOfCells() == 0)
-  {
-    return;
-  }
-  auto it = vtk::TakeSmartPointer(cells->NewIterator());
-  vtkIdType npts = 0;
-  const vtkIdType* pts = nullptr;
-  for (it->GoToFirstCell(); !it->IsDoneWithTraversal(); it->GoToNextCell())
-  {
-    it->GetCurrentCell(npts, pts);
-    switch (kind)
-    {
-      case CellKind::Vertex:
-        if (npts >= 1)
-        {
-          mesh.addCell({ pts[0] });
-        }
-        break;
-      case CellKind::Line:
-        if (npts >= 2)
-        {
-          mesh.addCell({ pts[0], pts[1] });
-        }
-        break;
-      case CellKind::Polygon:
-        mesh.Connectivity.insert(mesh.Connectivity.end(), pts, pts + npts);
-        mesh.Offsets.push_back(static_cast<std::int64_t>(mesh.Connectivity.size()));
-        break;
-      case CellKind::Strip:
-        for (vtkIdType i = 0; i + 2 < npts; ++i)
-        {
-          vtkIdType a = pts[i], b = pts[i + 1];
-          const vtkIdType c = pts[i + 2];
-          if (a == b || b == c || a == c)
-          {
-            continue;
-          }
-          if (i % 2 == 1)
-          {
-            std::swap(a, b); // odd triangles of a strip are wound the other way
-          }
-          mesh.addCell({ a, b, c });
-        }
-        break;
-    }
-  }
-}
-
-void ToPolygonMesh(vtkPolyData* input, sdfcage::PolygonMesh& mesh)
-{
-  const vtkIdType numberOfPoints = input->GetNumberOfPoints();
-  mesh.Points.resize(static_cast<std::size_t>(numberOfPoints));
-  double p[3];
-  for (vtkIdType i = 0; i < numberOfPoints; ++i)
-  {
-    input->GetPoint(i, p);
-    mesh.Points[static_cast<std::size_t>(i)] = sdfcage::Vec3(p[0], p[1], p[2]);
-  }
-  mesh.Offsets.assign(1, 0);
-  mesh.Connectivity.clear();
-  if (vtkCellArray* polys = input->GetPolys())
-  {
-    mesh.Connectivity.reserve(static_cast<std::size_t>(polys->GetNumberOfConnectivityIds()));
-    mesh.Offsets.reserve(static_cast<std::size_t>(polys->GetNumberOfCells()) + 1);
-  }
-  AppendCells(input->GetPolys(), CellKind::Polygon, mesh);
-  AppendCells(input->GetStrips(), CellKind::Strip, mesh);
-  AppendCells(input->GetVerts(), CellKind::Vertex, mesh);
-  AppendCells(input->GetLines(), CellKind::Line, mesh);
-}
-
-void ToPolyData(
-  const sdfcage::TriangleMesh& mesh, const std::vector<double>& distance, vtkPolyData* output)
-{
-  const vtkIdType numberOfPoints = static_cast<vtkIdType>(mesh.numberOfPoints());
-  const vtkIdType numberOfTriangles = static_cast<vtkIdType>(mesh.numberOfTriangles());
-
-  vtkNew<vtkPoints> points;
-  points->SetDataTypeToDouble();
-  points->SetNumberOfPoints(numberOfPoints);
-  for (vtkIdType i = 0; i < numberOfPoints; ++i)
-  {
-    points->SetPoint(i, mesh.Points[static_cast<std::size_t>(i)].data());
-  }
-
-  vtkNew<vtkIdTypeArray> offsets;
-  vtkNew<vtkIdTypeArray> connectivity;
-  offsets->SetNumberOfValues(numberOfTriangles + 1);
-  connectivity->SetNumberOfValues(3 * numberOfTriangles);
-  for (vtkIdType t = 0; t < numberOfTriangles; ++t)
-  {
-    const sdfcage::Triangle& tri = mesh.Triangles[static_cast<std::size_t>(t)];
-    offsets->SetValue(t, 3 * t);
-    connectivity->SetValue(3 * t, tri[0]);
-    connectivity->SetValue(3 * t + 1, tri[1]);
-    connectivity->SetValue(3 * t + 2, tri[2]);
-  }
-  offsets->SetValue(numberOfTriangles, 3 * numberOfTriangles);
-  vtkNew<vtkCellArray> polys;
-  polys->SetData(offsets, connectivity);
-
-  output->SetPoints(points);
-  output->SetPolys(polys);
-
-  if (static_cast<vtkIdType>(distance.size()) == numberOfPoints)
-  {
-    vtkNew<vtkDoubleArray> array;
-    array->SetName("DistanceToInput");
-    array->SetNumberOfValues(numberOfPoints);
-    for (vtkIdType i = 0; i < numberOfPoints; ++i)
-    {
-      array->SetValue(i, distance[static_cast<std::size_t>(i)]);
-    }
-    output->GetPointData()->SetScalars(array);
-  }
-}
-
-void ToImageData(const sdfcage::ScalarImage& field, vtkImageData* output)
-{
-  const auto& dims = field.Dimensions;
-  const std::size_t count =
-    static_cast<std::size_t>(dims[0]) * static_cast<std::size_t>(dims[1]) * dims[2];
-  if (dims[0] <= 0 || dims[1] <= 0 || dims[2] <= 0 || field.Values.size() != count)
-  {
-    return;
-  }
-  output->SetDimensions(dims[0], dims[1], dims[2]);
-  output->SetOrigin(field.Origin[0], field.Origin[1], field.Origin[2]);
-  output->SetSpacing(field.Spacing, field.Spacing, field.Spacing);
-  vtkNew<vtkFloatArray> values;
-  values->SetName("SignedDistance");
-  values->SetNumberOfValues(static_cast<vtkIdType>(count));
-  std::copy(field.Values.begin(), field.Values.end(), values->GetPointer(0));
-  output->GetPointData()->SetScalars(values);
-}
-
-// Machine-readable status identifiers (Core's statusName() is for humans).
-const char* StatusIdentifier(sdfcage::Status status)
-{
-  switch (status)
-  {
-    case sdfcage::Status::Ok:
-      return "Ok";
-    case sdfcage::Status::EmptyInput:
-      return "EmptyInput";
-    case sdfcage::Status::InvalidInput:
-      return "InvalidInput";
-    case sdfcage::Status::Cancelled:
-      return "Cancelled";
-    case sdfcage::Status::VerificationFailed:
-      return "VerificationFailed";
-    case sdfcage::Status::Failed:
-    default:
-      return "Failed";
-  }
-}
-
-template <typename ArrayT, typename ValueT>
-void AddFieldValue(vtkFieldData* fd, const char* name, ValueT value)
-{
-  vtkNew<ArrayT> array;
-  array->SetName(name);
-  array->SetNumberOfTuples(1);
-  array->SetValue(0, value);
-  fd->AddArray(array);
-}
-} // namespace
 
 //------------------------------------------------------------------------------
 vtkSDFCageFilter::vtkSDFCageFilter()
@@ -285,6 +54,11 @@ vtkSDFCageFilter::vtkSDFCageFilter()
   this->Adaptivity = defaults.Adaptivity;
   this->MaximumRefinements = defaults.MaximumRefinements;
   this->GenerateDistanceField = defaults.KeepDistanceField ? 1 : 0;
+  this->UseActivePoints = defaults.UseActivePoints ? 1 : 0;
+  this->ActiveRadius = defaults.ActivePoints.Radius;
+  this->GeodesicThreshold = defaults.ActivePoints.GeodesicThreshold;
+  this->AmplificationAlpha = defaults.ActivePoints.Alpha;
+  this->AmplificationBeta = defaults.ActivePoints.Beta;
   this->NumberOfThreads = defaults.NumberOfThreads;
 
   this->SetNumberOfInputPorts(1);
@@ -316,6 +90,9 @@ void vtkSDFCageFilter::ResetResults()
   this->EnvelopeComponents = 0;
   this->VoxelSizeUsed = 0.0;
   this->InputWasFlipped = false;
+  this->NumberOfActivePoints = 0;
+  this->ActivePointTime = 0.0;
+  this->TopologyWarning.clear();
   this->StatusString = "NotExecuted";
   this->LastErrorMessage.clear();
 }
@@ -373,6 +150,9 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
     AddFieldValue<vtkIntArray>(fd, "EnvelopeComponents", this->EnvelopeComponents);
     AddFieldValue<vtkDoubleArray>(fd, "VoxelSizeUsed", this->VoxelSizeUsed);
     AddFieldValue<vtkIntArray>(fd, "InputWasFlipped", this->InputWasFlipped ? 1 : 0);
+    AddFieldValue<vtkIdTypeArray>(fd, "NumberOfActivePoints", this->NumberOfActivePoints);
+    AddFieldValue<vtkDoubleArray>(fd, "ActivePointTime", this->ActivePointTime);
+    AddFieldValue<vtkStringArray>(fd, "TopologyWarning", this->TopologyWarning);
     AddFieldValue<vtkStringArray>(fd, "Status", this->StatusString);
     AddFieldValue<vtkStringArray>(fd, "LastErrorMessage", this->LastErrorMessage);
   };
@@ -414,6 +194,11 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
     options.Envelope.Adaptivity = this->Adaptivity;
     options.Envelope.MaximumRefinements = this->MaximumRefinements;
     options.Envelope.KeepDistanceField = this->GenerateDistanceField != 0;
+    options.Envelope.UseActivePoints = this->UseActivePoints != 0;
+    options.Envelope.ActivePoints.Radius = this->ActiveRadius;
+    options.Envelope.ActivePoints.GeodesicThreshold = this->GeodesicThreshold;
+    options.Envelope.ActivePoints.Alpha = this->AmplificationAlpha;
+    options.Envelope.ActivePoints.Beta = this->AmplificationBeta;
     options.Envelope.NumberOfThreads = this->NumberOfThreads;
 
     FilterProgress progress(this);
@@ -438,6 +223,9 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
     this->EnvelopeComponents = result.EnvelopeComponents;
     this->VoxelSizeUsed = result.VoxelSizeUsed;
     this->InputWasFlipped = result.Defects.FlippedOrientation;
+    this->NumberOfActivePoints = static_cast<vtkIdType>(result.NumberOfActivePoints);
+    this->ActivePointTime = result.ActivePointSeconds;
+    this->TopologyWarning = result.TopologyWarning;
     this->StatusString = StatusIdentifier(result.State);
     this->LastErrorMessage = result.Message;
 
@@ -490,6 +278,10 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
           << " asked for: " << (result.StopReason.empty() ? "no reason given" : result.StopReason);
       warnings.push_back(msg.str());
     }
+    if (!result.TopologyWarning.empty())
+    {
+      warnings.push_back(result.TopologyWarning);
+    }
     if (!warnings.empty())
     {
       std::ostringstream msg;
@@ -504,7 +296,8 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
     ToPolyData(result.Envelope, result.EnvelopeDistanceToInput, envelopeOutput);
     if (this->GenerateDistanceField)
     {
-      ToImageData(result.DistanceField, fieldOutput);
+      ToImageData(result.DistanceField, fieldOutput, "SignedDistance");
+      ToImageData(result.ModifiedDistanceField, fieldOutput, "ModifiedSignedDistance");
     }
     publish();
     this->UpdateProgress(1.0);
@@ -544,6 +337,13 @@ void vtkSDFCageFilter::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "MinimumClearance: " << this->MinimumClearance << "\n";
   os << indent << "Adaptivity: " << this->Adaptivity << "\n";
   os << indent << "MaximumRefinements: " << this->MaximumRefinements << "\n";
+  os << indent << "UseActivePoints: " << (this->UseActivePoints ? "On" : "Off") << "\n";
+  os << indent << "ActiveRadius: " << this->ActiveRadius << "\n";
+  os << indent << "GeodesicThreshold: " << this->GeodesicThreshold << "\n";
+  os << indent << "AmplificationAlpha: " << this->AmplificationAlpha << "\n";
+  os << indent << "AmplificationBeta: " << this->AmplificationBeta << "\n";
+  os << indent << "NumberOfActivePoints: " << this->NumberOfActivePoints << "\n";
+  os << indent << "TopologyWarning: " << this->TopologyWarning << "\n";
   os << indent << "GenerateDistanceField: " << (this->GenerateDistanceField ? "On" : "Off")
      << "\n";
   os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";

@@ -1,0 +1,192 @@
+/*=========================================================================
+
+  Program:   SDFCage
+  Module:    vtkActivePointFilter.cxx
+
+=========================================================================*/
+#include "vtkActivePointFilter.h"
+
+#include "vtkDoubleArray.h"
+#include "vtkFieldData.h"
+#include "vtkIdTypeArray.h"
+#include "vtkImageData.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkIntArray.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkPolyData.h"
+#include "vtkStringArray.h"
+#include "vtkUnsignedCharArray.h"
+
+#include "ActivePointAnalysis.h"
+#include "SDFCageVTKConversion.h"
+
+#include <exception>
+#include <new>
+
+vtkStandardNewMacro(vtkActivePointFilter);
+
+using namespace sdfcage_vtk;
+
+//------------------------------------------------------------------------------
+vtkActivePointFilter::vtkActivePointFilter()
+{
+  const sdfcage::ActivePointOptions defaults;
+  this->ActiveRadius = defaults.Radius;
+  this->GeodesicThreshold = defaults.GeodesicThreshold;
+  this->AmplificationAlpha = defaults.Alpha;
+  this->AmplificationBeta = defaults.Beta;
+  this->SetNumberOfOutputPorts(2);
+}
+
+//------------------------------------------------------------------------------
+vtkActivePointFilter::~vtkActivePointFilter() = default;
+
+//------------------------------------------------------------------------------
+int vtkActivePointFilter::FillOutputPortInformation(int port, vtkInformation* info)
+{
+  if (port == 1)
+  {
+    info->Set(vtkDataObject::DATA_TYPE_NAME(), "vtkImageData");
+    return 1;
+  }
+  return this->Superclass::FillOutputPortInformation(port, info);
+}
+
+//------------------------------------------------------------------------------
+int vtkActivePointFilter::RequestData(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkPolyData* input = vtkPolyData::GetData(inputVector[0], 0);
+  vtkPolyData* output = vtkPolyData::GetData(outputVector, 0);
+  vtkImageData* fields = vtkImageData::GetData(outputVector, 1);
+  this->NumberOfActivePoints = 0;
+  this->NumberOfActiveSamples = 0;
+  this->NumberOfSamples = 0;
+  this->ExecutionTime = 0.0;
+  this->LastErrorMessage.clear();
+  if (!output || !fields)
+  {
+    vtkErrorMacro(<< "Missing output.");
+    return 0;
+  }
+  output->Initialize();
+  fields->Initialize();
+
+  auto publish = [&]() {
+    vtkFieldData* fd = output->GetFieldData();
+    AddFieldValue<vtkIdTypeArray>(fd, "NumberOfActivePoints", this->NumberOfActivePoints);
+    AddFieldValue<vtkIdTypeArray>(fd, "NumberOfActiveSamples", this->NumberOfActiveSamples);
+    AddFieldValue<vtkIdTypeArray>(fd, "NumberOfSamples", this->NumberOfSamples);
+    AddFieldValue<vtkDoubleArray>(fd, "ActivePointTime", this->ExecutionTime);
+    AddFieldValue<vtkStringArray>(fd, "Status", this->StatusString);
+    AddFieldValue<vtkStringArray>(fd, "LastErrorMessage", this->LastErrorMessage);
+  };
+  auto fail = [&](sdfcage::Status status, const std::string& message) {
+    output->Initialize();
+    fields->Initialize();
+    this->StatusString = StatusIdentifier(status);
+    this->LastErrorMessage = message;
+    vtkErrorMacro(<< message);
+    publish();
+    return 0;
+  };
+
+  if (!input || input->GetNumberOfPoints() == 0 || input->GetNumberOfCells() == 0)
+  {
+    this->StatusString = StatusIdentifier(sdfcage::Status::EmptyInput);
+    publish();
+    return 1;
+  }
+
+  try
+  {
+    sdfcage::PolygonMesh mesh;
+    ToPolygonMesh(input, mesh);
+    sdfcage::ActivePointAnalysisOptions options;
+    options.ActivePoints.Radius = this->ActiveRadius;
+    options.ActivePoints.GeodesicThreshold = this->GeodesicThreshold;
+    options.ActivePoints.Alpha = this->AmplificationAlpha;
+    options.ActivePoints.Beta = this->AmplificationBeta;
+    options.GenerateFields = this->GenerateDistanceFields != 0;
+    options.NumberOfThreads = this->NumberOfThreads;
+    FilterProgress progress(this);
+    const sdfcage::ActivePointAnalysis result = sdfcage::analyzeActivePoints(mesh, options, &progress);
+    this->StatusString = StatusIdentifier(result.State);
+    this->ExecutionTime = result.Seconds;
+    switch (result.State)
+    {
+      case sdfcage::Status::Ok:
+        break;
+      case sdfcage::Status::EmptyInput:
+      case sdfcage::Status::Cancelled:
+        publish();
+        return 1;
+      default:
+        return fail(result.State, result.Message.empty() ? std::string("active points failed") : result.Message);
+    }
+    for (const std::string& w : result.Defects.warnings())
+    {
+      vtkWarningMacro(<< w);
+    }
+    ToPolyData(result.Mesh, {}, output);
+    const vtkIdType n = output->GetNumberOfPoints();
+    vtkNew<vtkUnsignedCharArray> active;
+    active->SetName("ActivePoint");
+    active->SetNumberOfValues(n);
+    vtkNew<vtkDoubleArray> geodesic;
+    geodesic->SetName("GeodesicDistanceToActive");
+    geodesic->SetNumberOfValues(n);
+    vtkNew<vtkDoubleArray> phi;
+    phi->SetName("Amplification");
+    phi->SetNumberOfValues(n);
+    for (vtkIdType i = 0; i < n; ++i)
+    {
+      const std::size_t k = static_cast<std::size_t>(i);
+      active->SetValue(i, result.Active[k]);
+      geodesic->SetValue(i, result.GeodesicToActive[k]);
+      phi->SetValue(i, result.Amplification[k]);
+    }
+    output->GetPointData()->SetScalars(active);
+    output->GetPointData()->AddArray(geodesic);
+    output->GetPointData()->AddArray(phi);
+    if (this->GenerateDistanceFields)
+    {
+      ToImageData(result.SignedDistance, fields, "SignedDistance");
+      ToImageData(result.ModifiedSignedDistance, fields, "ModifiedSignedDistance");
+    }
+    this->NumberOfActivePoints = static_cast<vtkIdType>(result.NumberOfActivePoints);
+    this->NumberOfActiveSamples = static_cast<vtkIdType>(result.NumberOfActiveSamples);
+    this->NumberOfSamples = static_cast<vtkIdType>(result.NumberOfSamples);
+    publish();
+    return 1;
+  }
+  catch (const std::bad_alloc&)
+  {
+    return fail(sdfcage::Status::Failed, "Out of memory while computing active points.");
+  }
+  catch (const std::exception& e)
+  {
+    return fail(sdfcage::Status::Failed, std::string("Active points failed: ") + e.what());
+  }
+  catch (...)
+  {
+    return fail(sdfcage::Status::Failed, "Active points failed with an unknown exception.");
+  }
+}
+
+//------------------------------------------------------------------------------
+void vtkActivePointFilter::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "ActiveRadius: " << this->ActiveRadius << "\n";
+  os << indent << "GeodesicThreshold: " << this->GeodesicThreshold << "\n";
+  os << indent << "AmplificationAlpha: " << this->AmplificationAlpha << "\n";
+  os << indent << "AmplificationBeta: " << this->AmplificationBeta << "\n";
+  os << indent << "GenerateDistanceFields: " << (this->GenerateDistanceFields ? "On" : "Off") << "\n";
+  os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";
+  os << indent << "NumberOfActivePoints: " << this->NumberOfActivePoints << "\n";
+  os << indent << "NumberOfActiveSamples: " << this->NumberOfActiveSamples << "\n";
+  os << indent << "Status: " << this->StatusString << "\n";
+}
