@@ -7,6 +7,7 @@
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Interpolation.h>
 #include <openvdb/tools/MeshToVolume.h>
+#include <openvdb/tools/Morphology.h>
 #include <openvdb/tools/VolumeToMesh.h>
 #include <openvdb/tree/LeafManager.h>
 
@@ -71,8 +72,9 @@ double phiAt(const ActivePoints& amp, const Vec3& x, int triangle, double distan
 
 /// xi -> phi * xi on the active voxels outside the input (values in (0, maxValue]); returns the
 /// number of voxels changed by more than 1e-3 relative.
+/// `noAdapt` (a topology copy of grid's tree) keeps on only the voxels where phi > 1.01.
 std::size_t amplify(openvdb::FloatGrid& grid, const openvdb::Int32Grid& index, const ActivePoints& amp,
-  double voxelSize, float maxValue)
+  double voxelSize, float maxValue, openvdb::BoolTree& noAdapt)
 {
   openvdb::tree::LeafManager<openvdb::FloatTree> leaves(grid.tree());
   std::atomic<std::size_t> changed{ 0 };
@@ -82,11 +84,16 @@ std::size_t amplify(openvdb::FloatGrid& grid, const openvdb::Int32Grid& index, c
     std::size_t local = 0;
     for (auto leaf = range.begin(); leaf; ++leaf)
     {
+      openvdb::BoolTree::LeafNodeType* maskLeaf = noAdapt.probeLeaf(leaf->origin());
       for (auto it = leaf->beginValueOn(); it; ++it)
       {
         const float v = *it;
         if (!(v > 0.0f) || v > maxValue)
         {
+          if (maskLeaf)
+          {
+            maskLeaf->setValueOff(it.pos());
+          }
           continue;
         }
         const openvdb::Coord ijk = it.getCoord();
@@ -101,12 +108,81 @@ std::size_t amplify(openvdb::FloatGrid& grid, const openvdb::Int32Grid& index, c
         {
           ++local;
         }
+        if (maskLeaf && !(phi > 1.0 + 0.01 * (amp.Alpha - 1.0)))
+        {
+          maskLeaf->setValueOff(it.pos());
+        }
         it.setValue(static_cast<float>(phi * v));
       }
     }
     changed += local;
   });
   return changed.load();
+}
+
+
+/// The isosurface {value = iso} of `grid` (unit-sphere units), quads split on the shorter
+/// diagonal, counter-clockwise seen from outside; no adaptivity inside `noAdapt`.
+TriangleMesh extract(const openvdb::FloatGrid& grid, double iso, double adaptivity, const openvdb::BoolTree::Ptr& noAdapt)
+{
+  openvdb::tools::VolumeToMesh mesher(iso, adaptivity, true);
+  if (noAdapt && adaptivity > 0.0)
+  {
+    mesher.setAdaptivityMask(noAdapt);
+  }
+  mesher(grid);
+  TriangleMesh s;
+  s.Points.resize(mesher.pointListSize());
+  const auto& pts = mesher.pointList();
+  for (std::size_t i = 0; i < s.Points.size(); ++i)
+  {
+    s.Points[i] = Vec3(pts[i].x(), pts[i].y(), pts[i].z());
+  }
+  const openvdb::tools::PolygonPoolList& pools = mesher.polygonPoolList();
+  for (std::size_t n = 0; n < mesher.polygonPoolListSize(); ++n)
+  {
+    const openvdb::tools::PolygonPool& pool = pools[n];
+    // OpenVDB's polygons wind clockwise seen from outside; we store counter-clockwise.
+    for (std::size_t i = 0; i < pool.numTriangles(); ++i)
+    {
+      const openvdb::Vec3I& t = pool.triangle(i);
+      s.Triangles.push_back({ static_cast<int>(t[0]), static_cast<int>(t[2]), static_cast<int>(t[1]) });
+    }
+    for (std::size_t i = 0; i < pool.numQuads(); ++i)
+    {
+      const openvdb::Vec4I& q = pool.quad(i);
+      const int a = q[0], b = q[1], c = q[2], d = q[3];
+      // split along the shorter diagonal (better-shaped triangles)
+      if ((s.Points[a] - s.Points[c]).squaredNorm() <= (s.Points[b] - s.Points[d]).squaredNorm())
+      {
+        s.Triangles.push_back({ a, c, b });
+        s.Triangles.push_back({ a, d, c });
+      }
+      else
+      {
+        s.Triangles.push_back({ a, d, b });
+        s.Triangles.push_back({ b, d, c });
+      }
+    }
+  }
+  return s;
+}
+
+/// Marks the voxels within `radius` voxels of each point (unit-sphere units).
+void markAround(const std::vector<Vec3>& points, double voxelSize, int radius, openvdb::BoolTree& mask)
+{
+  openvdb::tree::ValueAccessor<openvdb::BoolTree> acc(mask);
+  for (const Vec3& p : points)
+  {
+    const openvdb::Coord c(static_cast<int>(std::lround(p.x() / voxelSize)),
+      static_cast<int>(std::lround(p.y() / voxelSize)), static_cast<int>(std::lround(p.z() / voxelSize)));
+    for (int k = -radius; k <= radius; ++k)
+      for (int j = -radius; j <= radius; ++j)
+        for (int i = -radius; i <= radius; ++i)
+        {
+          acc.setValueOn(c.offsetBy(i, j, k), true);
+        }
+  }
 }
 
 } // namespace
@@ -214,7 +290,7 @@ bool computeDisplayFields(const TriangleMesh& unitMesh, double iso, double minSp
 
 IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSize, double iso,
   bool keepField, Progress* progress, const std::vector<double>& adaptivities,
-  const ActivePoints* amplification)
+  const ActivePoints* amplification, const SurfaceJudge* judge, int maxRepairs)
 {
   std::call_once(vdbInit, []() { openvdb::initialize(); });
   if (amplification && amplification->empty())
@@ -271,57 +347,66 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
     return out;
   }
   out.ActiveVoxels = grid->activeVoxelCount();
+  // Voxels where adaptivity is switched off: near active points (the amplified envelope lies
+  // close to the input there, merged polygons would cut into the clearance) and, after a failed
+  // judgement, around the triangles the judge points at.
+  openvdb::BoolTree::Ptr noAdapt(new openvdb::BoolTree(false));
   if (amplification)
   {
     // xi^ = phi xi (eq. 2–3) wherever the isosurface xi^ = iso can lie or be interpolated from:
     // phi >= 1, so only where xi <= iso (plus a voxel for the interpolation).
+    noAdapt.reset(new openvdb::BoolTree(grid->tree(), false, openvdb::TopologyCopy()));
     out.AmplifiedVoxels = amplify(*grid, *closestTriangle, *amplification, voxelSize,
-      static_cast<float>(iso + 2.0 * voxelSize));
+      static_cast<float>(iso + 2.0 * voxelSize), *noAdapt);
+    openvdb::tools::dilateActiveValues(*noAdapt, 1);
     closestTriangle.reset();
   }
 
   auto t1 = std::chrono::steady_clock::now();
-  for (const double adaptivity : adaptivities)
+  for (std::size_t k = 0; k < adaptivities.size(); ++k)
   {
-    std::vector<openvdb::Vec3s> meshPoints;
-    std::vector<openvdb::Vec3I> meshTris;
-    std::vector<openvdb::Vec4I> meshQuads;
-    try
+    const double adaptivity = adaptivities[k];
+    const int rounds = (judge && adaptivity > 0.0) ? 1 + std::max(0, maxRepairs) : 1;
+    for (int round = 0; round < rounds; ++round)
     {
-      openvdb::tools::volumeToMesh(*grid, meshPoints, meshTris, meshQuads, iso, adaptivity, true);
-    }
-    catch (const std::exception& e)
-    {
-      out.Error = std::string("OpenVDB could not extract the isosurface: ") + e.what();
-      return out;
-    }
-    out.Surfaces.emplace_back();
-    TriangleMesh& s = out.Surfaces.back();
-    s.Points.resize(meshPoints.size());
-    for (std::size_t i = 0; i < meshPoints.size(); ++i)
-    {
-      s.Points[i] = Vec3(meshPoints[i].x(), meshPoints[i].y(), meshPoints[i].z());
-    }
-    s.Triangles.reserve(meshTris.size() + 2 * meshQuads.size());
-    // OpenVDB's polygons wind clockwise seen from outside; we store counter-clockwise.
-    for (const auto& t : meshTris)
-    {
-      s.Triangles.push_back({ static_cast<int>(t[0]), static_cast<int>(t[2]), static_cast<int>(t[1]) });
-    }
-    for (const auto& q : meshQuads)
-    {
-      const int a = q[0], b = q[1], c = q[2], d = q[3];
-      // split along the shorter diagonal (better-shaped triangles)
-      if ((s.Points[a] - s.Points[c]).squaredNorm() <= (s.Points[b] - s.Points[d]).squaredNorm())
+      TriangleMesh surface;
+      try
       {
-        s.Triangles.push_back({ a, c, b });
-        s.Triangles.push_back({ a, d, c });
+        surface = extract(*grid, iso, adaptivity, noAdapt->empty() ? nullptr : noAdapt);
       }
-      else
+      catch (const std::exception& e)
       {
-        s.Triangles.push_back({ a, d, b });
-        s.Triangles.push_back({ b, d, c });
+        out.Error = std::string("OpenVDB could not extract the isosurface: ") + e.what();
+        return out;
       }
+      if (!judge)
+      {
+        out.Surfaces.push_back(std::move(surface));
+        break;
+      }
+      std::vector<Vec3> repairNear;
+      const bool accepted = (*judge)(surface, adaptivity, repairNear);
+      if (progressCancelled(progress))
+      {
+        out.Cancelled = true;
+        return out;
+      }
+      if (accepted)
+      {
+        out.Surfaces.push_back(std::move(surface));
+        out.AcceptedAdaptivity = adaptivity;
+        out.Repairs = round;
+        break;
+      }
+      if (repairNear.empty() || adaptivity <= 0.0)
+      {
+        break;
+      }
+      markAround(repairNear, voxelSize, 2, *noAdapt);
+    }
+    if (!out.Surfaces.empty() && judge)
+    {
+      break;
     }
   }
   progressUpdate(progress, 0.9);

@@ -128,6 +128,86 @@ TriangleMesh outerBoundary(const TriangleMesh& surface, int& removed)
   return keepTriangles(surface, keep);
 }
 
+
+/// Where a failed surface is wrong: points on every triangle (sampled about one voxel apart)
+/// that crosses another triangle or comes closer than `clearance` to the input.
+std::vector<Vec3> defectLocations(const TriangleMesh& input, const TriangleMesh& surface, double clearance, double voxel)
+{
+  const std::size_t nf = surface.Triangles.size();
+  std::vector<char> bad(nf, 0);
+  // self-intersections
+  {
+    TriangleIndex index;
+    index.build(surface);
+    const double foldCosine = -1.0 + 1e-12;
+    const auto box = bounds(surface);
+    const double touching = 1e-12 * std::max(1.0, (box[1] - box[0]).norm());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t f = r.begin(); f != r.end(); ++f)
+      {
+        const Triangle& t = surface.Triangles[f];
+        const int ia[3] = { t[0], t[1], t[2] };
+        const Vec3 pa[3] = { surface.Points[t[0]], surface.Points[t[1]], surface.Points[t[2]] };
+        const Vec3 lo = pa[0].cwiseMin(pa[1]).cwiseMin(pa[2]);
+        const Vec3 hi = pa[0].cwiseMax(pa[1]).cwiseMax(pa[2]);
+        index.forEachTriangleInBox(lo, hi, [&](int g) {
+          if (static_cast<std::size_t>(g) == f || bad[f])
+          {
+            return;
+          }
+          const Triangle& o = surface.Triangles[g];
+          const int ib[3] = { o[0], o[1], o[2] };
+          const Vec3 pb[3] = { surface.Points[o[0]], surface.Points[o[1]], surface.Points[o[2]] };
+          if (trianglesConflict(ia, pa, ib, pb, touching, foldCosine))
+          {
+            bad[f] = 1; // each triangle only writes its own flag
+          }
+        });
+      }
+    });
+  }
+  // clearance
+  {
+    const TriangleTree tree(input);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t f = r.begin(); f != r.end(); ++f)
+      {
+        if (bad[f])
+        {
+          continue;
+        }
+        const Triangle& t = surface.Triangles[f];
+        const Vec3 tri[3] = { surface.Points[t[0]], surface.Points[t[1]], surface.Points[t[2]] };
+        if (tree.anyCloserThan(tri, clearance))
+        {
+          bad[f] = 1;
+        }
+      }
+    });
+  }
+  std::vector<Vec3> points;
+  for (std::size_t f = 0; f < nf; ++f)
+  {
+    if (!bad[f])
+    {
+      continue;
+    }
+    const Triangle& t = surface.Triangles[f];
+    const Vec3 &a = surface.Points[t[0]], &b = surface.Points[t[1]], &c = surface.Points[t[2]];
+    const double longest = std::max({ (b - a).norm(), (c - b).norm(), (a - c).norm() });
+    const int steps = std::max(1, static_cast<int>(std::ceil(longest / voxel)));
+    for (int i = 0; i <= steps; ++i)
+    {
+      for (int j = 0; i + j <= steps; ++j)
+      {
+        const double u = static_cast<double>(i) / steps, v = static_cast<double>(j) / steps;
+        points.push_back(a + u * (b - a) + v * (c - a));
+      }
+    }
+  }
+  return points;
+}
+
 } // namespace
 
 long long countSelfIntersections(const TriangleMesh& mesh, Progress* progress)
@@ -401,12 +481,57 @@ EnvelopeResult buildEnvelope(
       adaptivities = { options.Adaptivity, 0.0 };
     }
     progressStage(progress, "distance field and isosurface", fieldBegin, 0.7 * progressEnd);
-    IsosurfaceOutput iso =
-      computeIsosurface(unitInput, h, c, options.KeepDistanceField, progress, adaptivities, amplification);
+    // Each extracted surface is judged here: outer boundary, then the full verification. A
+    // failing adaptive surface is re-extracted with adaptivity off around its defects.
+    bool accepted = false;
+    const SurfaceJudge judge = [&](const TriangleMesh& surface, double adaptivity, std::vector<Vec3>& repairNear) {
+      auto t0 = std::chrono::steady_clock::now();
+      int pockets = 0;
+      TriangleMesh envelope = outerBoundary(surface, pockets);
+      result.IsosurfaceSeconds += seconds(t0);
+      progressStage(progress, "verifying enclosure", 0.7 * progressEnd, progressEnd);
+      auto t1 = std::chrono::steady_clock::now();
+      std::string why;
+      double clearance = 0.0;
+      std::vector<double> distances;
+      const bool ok = verifyEnclosure(unitInput, envelope, delta, clearance, why, &distances, progress,
+        options.ExactEnvelopeClearance);
+      ++attempt;
+      if (ok)
+      {
+        result.Envelope = std::move(envelope);
+        result.DistanceToInput = std::move(distances);
+        result.MinimumClearance = clearance;
+        result.RemovedPockets = pockets;
+        result.VoxelSizeUsed = h;
+        result.AdaptivityUsed = adaptivity;
+        result.Refinements = level;
+        accepted = true;
+      }
+      else if (!progressCancelled(progress))
+      {
+        std::ostringstream m;
+        m << "envelope at voxel size " << h << " (adaptivity " << adaptivity << ") failed verification: " << why;
+        result.Message = m.str();
+        if (std::getenv("SDFCAGE_DEBUG_ENVELOPE"))
+        {
+          std::fprintf(stderr, "%s\n", result.Message.c_str());
+        }
+        if (adaptivity > 0.0)
+        {
+          repairNear = defectLocations(unitInput, envelope, delta, h);
+        }
+      }
+      result.VerificationSeconds += seconds(t1);
+      return ok;
+    };
+    IsosurfaceOutput iso = computeIsosurface(
+      unitInput, h, c, options.KeepDistanceField, progress, adaptivities, amplification, &judge, 4);
     result.AmplifiedVoxels = iso.AmplifiedVoxels;
+    result.AdaptiveRepairs = iso.Repairs;
     result.DistanceFieldSeconds += iso.DistanceFieldSeconds;
     result.IsosurfaceSeconds += iso.IsosurfaceSeconds;
-    if (iso.Cancelled)
+    if (iso.Cancelled || progressCancelled(progress))
     {
       result.State = Status::Cancelled;
       result.Message = "cancelled";
@@ -420,62 +545,32 @@ EnvelopeResult buildEnvelope(
     }
     result.DistanceField = std::move(iso.Field);
     result.ModifiedDistanceField = std::move(iso.ModifiedField);
-    for (std::size_t k = 0; k < iso.Surfaces.size(); ++k, ++attempt)
+    if (accepted)
     {
-      auto t0 = std::chrono::steady_clock::now();
-      result.Envelope = outerBoundary(iso.Surfaces[k], result.RemovedPockets);
-      result.IsosurfaceSeconds += seconds(t0);
-      result.VoxelSizeUsed = h;
-      result.Refinements = attempt;
-      result.AdaptivityUsed = adaptivities[k];
-
-      progressStage(progress, "verifying enclosure", 0.7 * progressEnd, progressEnd);
-      auto t1 = std::chrono::steady_clock::now();
-      std::string why;
-      const bool ok = verifyEnclosure(unitInput, result.Envelope, delta, result.MinimumClearance, why,
-        &result.DistanceToInput, progress, options.ExactEnvelopeClearance);
-      result.VerificationSeconds += seconds(t1);
-      if (progressCancelled(progress))
+      std::vector<int> comp;
+      result.Components = triangleComponents(result.Envelope, comp);
+      result.Genus = genus(result.Envelope);
+      if (result.Genus != result.InputGenus || result.Components != result.InputComponents)
       {
-        result.State = Status::Cancelled;
-        result.Message = "cancelled";
-        return result;
-      }
-      if (ok)
-      {
-        std::vector<int> comp;
-        result.Components = triangleComponents(result.Envelope, comp);
-        result.Genus = genus(result.Envelope);
-        if (result.Genus != result.InputGenus || result.Components != result.InputComponents)
+        std::ostringstream w;
+        w << "the envelope has genus " << result.Genus << " and " << result.Components
+          << " component(s), the input genus " << result.InputGenus << " and "
+          << result.InputComponents << ": parts of the input closer than the parameters can "
+          << "separate were fused";
+        if (!options.UseActivePoints)
         {
-          std::ostringstream w;
-          w << "the envelope has genus " << result.Genus << " and " << result.Components
-            << " component(s), the input genus " << result.InputGenus << " and "
-            << result.InputComponents << ": parts of the input closer than the parameters can "
-            << "separate were fused";
-          if (!options.UseActivePoints)
-          {
-            w << " (active points are off: turn them on)";
-          }
-          else
-          {
-            w << " (try a smaller IsoValue and VoxelSize, or a larger ActiveRadius / AmplificationAlpha)";
-          }
-          result.TopologyWarning = w.str();
+          w << " (active points are off: turn them on)";
         }
-        result.EnclosureVerified = true;
-        result.State = Status::Ok;
-        result.Message.clear();
-        return result;
+        else
+        {
+          w << " (try a smaller IsoValue and VoxelSize, or a larger ActiveRadius / AmplificationAlpha)";
+        }
+        result.TopologyWarning = w.str();
       }
-      std::ostringstream s;
-      s << "envelope at voxel size " << h << " (adaptivity " << adaptivities[k]
-        << ") failed verification: " << why;
-      result.Message = s.str();
-      if (std::getenv("SDFCAGE_DEBUG_ENVELOPE"))
-      {
-        std::fprintf(stderr, "%s\n", result.Message.c_str());
-      }
+      result.EnclosureVerified = true;
+      result.State = Status::Ok;
+      result.Message.clear();
+      return result;
     }
   }
   result.State = Status::VerificationFailed;

@@ -81,7 +81,8 @@ struct EnvelopeResult
   int Components = 0;               ///< components of the kept envelope
   int Genus = 0;                    ///< genus of the kept envelope
   double VoxelSizeUsed = 0.0;       ///< after any refinement
-  int Refinements = 0;              ///< extra attempts needed (adaptivity off, finer grids)
+  int Refinements = 0;              ///< finer grids needed (0: the requested voxel size)
+  int AdaptiveRepairs = 0;          ///< re-extractions with adaptivity switched off around defects
   double AdaptivityUsed = 0.0;      ///< adaptivity of the accepted envelope
   double DistanceFieldSeconds = 0.0;
   double IsosurfaceSeconds = 0.0;
