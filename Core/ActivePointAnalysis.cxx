@@ -33,14 +33,16 @@ ActivePointAnalysis analyzeActivePoints(
   }
   progressStage(progress, "validating input", 0.0, 0.02);
   result.Defects = prepareMesh(input, result.Mesh, options.Validation);
-  if (result.Mesh.empty())
+  // as generateCage: nothing usable at all is "empty", a defect is an error naming it
+  if (result.Defects.Empty && !result.Defects.usable() && result.Defects.NonFinitePoints == 0 &&
+    result.Defects.InvalidPointIds == 0 && result.Defects.UntriangulatedPolygons == 0)
   {
-    result.State = result.Defects.usable() ? Status::EmptyInput : Status::InvalidInput;
-    result.Message = result.Defects.usable() ? "the input has no triangles" : result.Defects.errorMessage();
+    result.State = Status::EmptyInput;
+    result.Message = "the input has no triangles";
     result.Mesh = TriangleMesh();
     return result;
   }
-  if (!result.Defects.usable())
+  if (!result.Defects.usable() || result.Mesh.empty())
   {
     result.State = Status::InvalidInput;
     result.Message = result.Defects.errorMessage();

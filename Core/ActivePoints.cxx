@@ -300,82 +300,92 @@ double ActivePoints::amplificationAt(int t, const Vec3& closest, double distance
   return this->phi(this->geodesicAt(t, w) + distance);
 }
 
+std::size_t splitEdges(TriangleMesh& mesh, const std::function<bool(int, int)>& split,
+  std::vector<std::array<int, 2>>* parents)
+{
+  std::unordered_map<std::uint64_t, int> midpoints;
+  auto mid = [&](int a, int b) {
+    const std::uint64_t key = (static_cast<std::uint64_t>(std::min(a, b)) << 32) |
+      static_cast<std::uint32_t>(std::max(a, b));
+    auto it = midpoints.find(key);
+    if (it != midpoints.end())
+    {
+      return it->second;
+    }
+    const int id = static_cast<int>(mesh.Points.size());
+    mesh.Points.push_back(0.5 * (mesh.Points[a] + mesh.Points[b]));
+    if (parents)
+    {
+      parents->push_back({ a, b });
+    }
+    midpoints.emplace(key, id);
+    return id;
+  };
+  // both triangles of an edge ask the same question, so the marking is conforming; the
+  // predicate must be symmetric
+  std::vector<Triangle> next;
+  next.reserve(mesh.Triangles.size() + mesh.Triangles.size() / 2);
+  for (const Triangle& t : mesh.Triangles)
+  {
+    bool marked[3];
+    int count = 0;
+    for (int k = 0; k < 3; ++k)
+    {
+      marked[k] = split(t[k], t[(k + 1) % 3]);
+      count += marked[k];
+    }
+    if (count == 0)
+    {
+      next.push_back(t);
+    }
+    else if (count == 1)
+    {
+      const int k = marked[0] ? 0 : (marked[1] ? 1 : 2);
+      const int a = t[k], b = t[(k + 1) % 3], o = t[(k + 2) % 3];
+      const int m = mid(a, b);
+      next.push_back({ a, m, o });
+      next.push_back({ m, b, o });
+    }
+    else if (count == 2)
+    {
+      const int j = !marked[0] ? 0 : (!marked[1] ? 1 : 2); // the unmarked edge (a, b)
+      const int a = t[j], b = t[(j + 1) % 3], c = t[(j + 2) % 3];
+      const int m1 = mid(b, c), m2 = mid(c, a);
+      next.push_back({ m1, c, m2 });
+      if ((mesh.Points[a] - mesh.Points[m1]).squaredNorm() <= (mesh.Points[b] - mesh.Points[m2]).squaredNorm())
+      {
+        next.push_back({ a, b, m1 });
+        next.push_back({ a, m1, m2 });
+      }
+      else
+      {
+        next.push_back({ a, b, m2 });
+        next.push_back({ b, m1, m2 });
+      }
+    }
+    else
+    {
+      const int m01 = mid(t[0], t[1]), m12 = mid(t[1], t[2]), m20 = mid(t[2], t[0]);
+      next.push_back({ t[0], m01, m20 });
+      next.push_back({ m01, t[1], m12 });
+      next.push_back({ m20, m12, t[2] });
+      next.push_back({ m01, m12, m20 });
+    }
+  }
+  mesh.Triangles.swap(next);
+  return midpoints.size();
+}
+
 bool refineMesh(const TriangleMesh& mesh, double maxEdge, TriangleMesh& out, std::size_t maxTriangles)
 {
   out = mesh;
   const double m2 = maxEdge * maxEdge;
   for (int round = 0; round < 64; ++round)
   {
-    std::unordered_map<std::uint64_t, int> midpoints;
-    auto mid = [&](int a, int b) {
-      const std::uint64_t key = (static_cast<std::uint64_t>(std::min(a, b)) << 32) |
-        static_cast<std::uint32_t>(std::max(a, b));
-      auto it = midpoints.find(key);
-      if (it != midpoints.end())
-      {
-        return it->second;
-      }
-      const int id = static_cast<int>(out.Points.size());
-      out.Points.push_back(0.5 * (out.Points[a] + out.Points[b]));
-      midpoints.emplace(key, id);
-      return id;
-    };
-    auto isLong = [&](int a, int b) { return (out.Points[a] - out.Points[b]).squaredNorm() > m2; };
-    std::vector<Triangle> next;
-    next.reserve(out.Triangles.size() * 2);
-    bool split = false;
-    for (const Triangle& t : out.Triangles)
-    {
-      bool marked[3];
-      int count = 0;
-      for (int k = 0; k < 3; ++k)
-      {
-        marked[k] = isLong(t[k], t[(k + 1) % 3]);
-        count += marked[k];
-      }
-      if (count == 0)
-      {
-        next.push_back(t);
-        continue;
-      }
-      split = true;
-      if (count == 1)
-      {
-        const int k = marked[0] ? 0 : (marked[1] ? 1 : 2);
-        const int a = t[k], b = t[(k + 1) % 3], o = t[(k + 2) % 3];
-        const int m = mid(a, b);
-        next.push_back({ a, m, o });
-        next.push_back({ m, b, o });
-      }
-      else if (count == 2)
-      {
-        const int j = !marked[0] ? 0 : (!marked[1] ? 1 : 2); // the short edge (a, b)
-        const int a = t[j], b = t[(j + 1) % 3], c = t[(j + 2) % 3];
-        const int m1 = mid(b, c), m2i = mid(c, a);
-        next.push_back({ m1, c, m2i });
-        const Vec3& P = out.Points[a];
-        if ((P - out.Points[m1]).squaredNorm() <= (out.Points[b] - out.Points[m2i]).squaredNorm())
-        {
-          next.push_back({ a, b, m1 });
-          next.push_back({ a, m1, m2i });
-        }
-        else
-        {
-          next.push_back({ a, b, m2i });
-          next.push_back({ b, m1, m2i });
-        }
-      }
-      else
-      {
-        const int m01 = mid(t[0], t[1]), m12 = mid(t[1], t[2]), m20 = mid(t[2], t[0]);
-        next.push_back({ t[0], m01, m20 });
-        next.push_back({ m01, t[1], m12 });
-        next.push_back({ m20, m12, t[2] });
-        next.push_back({ m01, m12, m20 });
-      }
-    }
-    out.Triangles.swap(next);
-    if (!split)
+    const std::size_t created = splitEdges(out, [&](int a, int b) {
+      return (out.Points[a] - out.Points[b]).squaredNorm() > m2;
+    });
+    if (created == 0)
     {
       return true;
     }
@@ -427,28 +437,53 @@ ActivePoints computeActivePoints(const TriangleMesh& unitInput, const ActivePoin
     }
   }
 
-  // Samples: greedy, in point order (deterministic), no two closer than half the spacing, so
-  // that every point lies within half a spacing of a sample.
+  // Samples: greedy, in point order (deterministic): a point not yet within half a spacing of a
+  // sample *along the surface* becomes one. (A Euclidean cover would let one part's samples
+  // stand for a nearly touching other part, which then has no samples of its own.)
+  const EdgeGraph graph(S);
   const double separation = 0.5 * spacing;
   std::vector<int> samples;
   {
-    PointGrid grid(S.Points, all, separation);
-    std::vector<char> chosen(n, 0);
+    std::vector<char> covered(n, 0);
+    Search cover(n);
     for (int id : all)
     {
-      bool near = false;
-      grid.forEachWithin(S.Points[id], separation, [&](int q) { near = near || chosen[q]; });
-      if (!near)
+      if (covered[id])
       {
-        chosen[id] = 1;
-        samples.push_back(id);
+        continue;
+      }
+      samples.push_back(id);
+      const std::uint32_t now = ++cover.Now;
+      cover.Heap.clear();
+      cover.Dist[id] = 0.0;
+      cover.Seen[id] = now;
+      pushHeap(cover.Heap, 0.0, id);
+      while (!cover.Heap.empty())
+      {
+        const auto [d, u] = popHeap(cover.Heap);
+        if (cover.Settled[u] == now || d > cover.Dist[u])
+        {
+          continue;
+        }
+        cover.Settled[u] = now;
+        covered[u] = 1;
+        for (std::size_t e = graph.Start[u]; e < graph.Start[u + 1]; ++e)
+        {
+          const int v = graph.Neighbor[e];
+          const double nd = d + graph.Length[e];
+          if (nd <= separation && cover.Settled[v] != now && (cover.Seen[v] != now || nd < cover.Dist[v]))
+          {
+            cover.Seen[v] = now;
+            cover.Dist[v] = nd;
+            pushHeap(cover.Heap, nd, v);
+          }
+        }
       }
     }
   }
   result.NumberOfSamples = samples.size();
   progressUpdate(progress, 0.1);
 
-  const EdgeGraph graph(S);
   const PointGrid sampleGrid(S.Points, samples, r);
   std::unique_ptr<std::atomic<std::uint8_t>[]> active(new std::atomic<std::uint8_t>[n]);
   for (std::size_t i = 0; i < n; ++i)

@@ -4,7 +4,9 @@
 
 #include "Mesh.h"
 
+#include <array>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -71,6 +73,12 @@ struct ActivePoints
 /// neighbour is reached. Threaded and deterministic.
 ActivePoints computeActivePoints(
   const TriangleMesh& unitInput, const ActivePointOptions& options, Progress* progress = nullptr);
+
+/// One round of conforming red-green refinement: every edge for which split(a, b) (symmetric)
+/// holds gets its midpoint, appended to mesh.Points (with its edge in `parents`); triangles are
+/// split 1-2, 1-3 or 1-4 keeping their orientation. Returns the number of midpoints added.
+std::size_t splitEdges(TriangleMesh& mesh, const std::function<bool(int, int)>& split,
+  std::vector<std::array<int, 2>>* parents = nullptr);
 
 /// Splits edges (conforming red-green refinement) until none is longer than `maxEdge`; the
 /// points of `mesh` keep their indices. Stops after `maxTriangles` triangles (returns false).

@@ -18,6 +18,7 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <sstream>
 
 namespace sdfcage
@@ -206,6 +207,74 @@ std::vector<Vec3> defectLocations(const TriangleMesh& input, const TriangleMesh&
     }
   }
   return points;
+}
+
+/// Near active points the isosurface xi^ = c lies at xi = c / phi, closer to the input than the
+/// grid resolves (a voxel is c/2, the offset there down to c/alpha): its chords cut corners.
+/// There, the envelope is refined (edges split down to `maxEdge`) and every vertex where phi is
+/// noticeably above 1 is moved along the distance gradient (away from its closest input point)
+/// onto the exact solution of phi(g_A + d) d = c. Returns the number of vertices moved.
+std::size_t projectOntoAmplifiedOffset(
+  TriangleMesh& envelope, const ActivePoints& amp, const TriangleTree& tree, double c, double maxEdge)
+{
+  std::vector<char> amplified;
+  std::vector<double> offset; // distance to the input after the projection
+  std::atomic<std::size_t> moved{ 0 };
+  auto project = [&](std::size_t begin) {
+    amplified.resize(envelope.Points.size(), 0);
+    offset.resize(envelope.Points.size(), 0.0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, envelope.Points.size(), 1024),
+      [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i)
+        {
+          Vec3& x = envelope.Points[i];
+          Vec3 cp;
+          int t = -1;
+          double d = 0.0;
+          if (!tree.closestPoint(x, 2.0 * c, cp, t, d) || !(d > 0.0))
+          {
+            continue;
+          }
+          if (!(amp.amplificationAt(t, cp, d) > 1.0 + 1e-3 * (amp.Alpha - 1.0)))
+          {
+            continue;
+          }
+          // f(s) = phi(g + s) s - c is increasing on the relevant range: f(0) < 0 <= f(c)
+          double lo = 0.0, hi = c;
+          for (int k = 0; k < 40; ++k)
+          {
+            const double mid = 0.5 * (lo + hi);
+            (amp.amplificationAt(t, cp, mid) * mid < c ? lo : hi) = mid;
+          }
+          x = cp + (x - cp) * (hi / d);
+          amplified[i] = 1;
+          offset[i] = hi;
+          ++moved;
+        }
+      });
+  };
+  project(0);
+  const double m2 = maxEdge * maxEdge;
+  for (int round = 0; round < 3; ++round)
+  {
+    const std::size_t before = envelope.Points.size();
+    // only chords that sag: where the offset surface curves (around rims and edges of the
+    // input) its chords come closer to the input than their ends; flat parts are left alone
+    const std::size_t created = splitEdges(envelope, [&](int a, int b) {
+      if (!(amplified[a] && amplified[b]) || (envelope.Points[a] - envelope.Points[b]).squaredNorm() <= m2)
+      {
+        return false;
+      }
+      const double sag = tree.distance(0.5 * (envelope.Points[a] + envelope.Points[b]));
+      return sag < 0.9 * std::min(offset[a], offset[b]);
+    });
+    if (created == 0)
+    {
+      break;
+    }
+    project(before);
+  }
+  return moved.load();
 }
 
 } // namespace
@@ -445,6 +514,7 @@ EnvelopeResult buildEnvelope(
   }
   ActivePoints active;
   const ActivePoints* amplification = nullptr;
+  std::unique_ptr<TriangleTree> surfaceTree;
   if (options.UseActivePoints)
   {
     const std::string bad = options.ActivePoints.validate();
@@ -466,6 +536,10 @@ EnvelopeResult buildEnvelope(
     result.NumberOfActivePoints = active.NumberOfActiveInputPoints;
     result.NumberOfActiveSamples = active.NumberOfActiveSamples;
     amplification = &active;
+    if (!active.empty())
+    {
+      surfaceTree = std::make_unique<TriangleTree>(active.Surface);
+    }
   }
   const double fieldBegin = options.UseActivePoints ? 0.12 * progressEnd : 0.02;
   // Attempts: the requested grid, first with the requested adaptivity and, if that envelope fails
@@ -488,6 +562,10 @@ EnvelopeResult buildEnvelope(
       auto t0 = std::chrono::steady_clock::now();
       int pockets = 0;
       TriangleMesh envelope = outerBoundary(surface, pockets);
+      if (amplification && surfaceTree)
+      {
+        result.ProjectedVertices = projectOntoAmplifiedOffset(envelope, *amplification, *surfaceTree, c, 0.5 * h);
+      }
       result.IsosurfaceSeconds += seconds(t0);
       progressStage(progress, "verifying enclosure", 0.7 * progressEnd, progressEnd);
       auto t1 = std::chrono::steady_clock::now();

@@ -82,6 +82,7 @@ struct EnvelopeResult
   int Genus = 0;                    ///< genus of the kept envelope
   double VoxelSizeUsed = 0.0;       ///< after any refinement
   int Refinements = 0;              ///< finer grids needed (0: the requested voxel size)
+  std::size_t ProjectedVertices = 0; ///< vertices moved onto the exact amplified offset
   int AdaptiveRepairs = 0;          ///< re-extractions with adaptivity switched off around defects
   double AdaptivityUsed = 0.0;      ///< adaptivity of the accepted envelope
   double DistanceFieldSeconds = 0.0;
