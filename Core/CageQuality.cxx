@@ -647,15 +647,24 @@ CageQualityResult evaluateCage(const TriangleMesh& inputMesh, const TriangleMesh
     return finish();
   }
 
-  // --- mean distance over the cage (midpoint rule on 4^level sub-triangles per triangle) ---
+  // --- mean distance over the cage (midpoint rule on 4^level sub-triangles per triangle, the level
+  // chosen per triangle from its size) ---
   progressStage(progress, "mean distance", 0.7, 0.8);
-  const int n = 1 << std::clamp(options.MeanDistanceLevel, 0, 6);
+  const double spacing = std::max(options.MeanDistanceSpacing, 1e-6) * r.Diagonal;
+  const int minimumLevel = std::clamp(options.MinimumMeanDistanceLevel, 0, 6);
   std::vector<double> cellArea(nf), cellMean(nf), cellMax(nf);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 8), [&](const tbb::blocked_range<std::size_t>& rg) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 4), [&](const tbb::blocked_range<std::size_t>& rg) {
     for (std::size_t f = rg.begin(); f != rg.end(); ++f)
     {
       const Triangle& t = cage.Triangles[f];
       const Vec3 &a = cage.Points[t[0]], &b = cage.Points[t[1]], &c = cage.Points[t[2]];
+      const double edge = std::max({ (b - a).norm(), (c - b).norm(), (a - c).norm() });
+      int level = minimumLevel;
+      while (level < 6 && edge > spacing * static_cast<double>(1 << level))
+      {
+        ++level;
+      }
+      const int n = 1 << level;
       double m = std::max({ cageDistance[t[0]], cageDistance[t[1]], cageDistance[t[2]] });
       double s = 0.0;
       auto at = [&](double u, double v) {

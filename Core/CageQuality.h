@@ -27,9 +27,12 @@ struct CageQualityOptions
   double HausdorffTolerance = 1e-4;
   /// Maximum number of extra point-distance evaluations per Hausdorff direction.
   long long HausdorffBudget = 400000;
-  /// Each cage triangle is split into 4^MeanDistanceLevel sub-triangles whose centroids give the
-  /// area-weighted mean distance (midpoint rule) and samples for the per-cell maximum.
-  int MeanDistanceLevel = 2;
+  /// Each cage triangle is split into 4^L sub-triangles whose centroids give the area-weighted
+  /// mean distance (midpoint rule) and samples for the per-cell maximum: L is the smallest level
+  /// that brings the sub-triangles' edges to MeanDistanceSpacing x diagonal, at least
+  /// MinimumMeanDistanceLevel and at most 6 (4096 points per triangle).
+  double MeanDistanceSpacing = 0.01;
+  int MinimumMeanDistanceLevel = 2;
 };
 
 /// Everything evaluateCage() measured. Lengths in the meshes' own units; "Relative" values are
