@@ -64,16 +64,20 @@ std::vector<char> referencedMask(const TriangleMesh& mesh)
   return used;
 }
 
-/// Distance of every referenced point of `mesh` to the surface in `tree` (NaN for the others).
-std::vector<double> pointDistances(const TriangleMesh& mesh, const std::vector<char>& used, const TriangleTree& tree)
+/// Distance of every referenced point of `mesh` to the surface in `tree` (NaN for the others),
+/// and the closest triangle of the tree's mesh (-1 for the others).
+std::vector<double> pointDistances(const TriangleMesh& mesh, const std::vector<char>& used, const TriangleTree& tree,
+  std::vector<int>& nearest)
 {
   std::vector<double> d(mesh.Points.size(), kNaN);
+  nearest.assign(mesh.Points.size(), -1);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, d.size(), 512), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t i = r.begin(); i != r.end(); ++i)
     {
       if (used[i])
       {
-        d[i] = tree.distance(mesh.Points[i]);
+        Vec3 q;
+        tree.closestPoint(mesh.Points[i], -1.0, q, nearest[i], d[i]);
       }
     }
   });
@@ -109,29 +113,73 @@ struct UnionFind
 };
 
 // ---- Hausdorff distance by branch and bound ----------------------------------------------------
-// The distance to a surface is 1-Lipschitz, so on a triangle with corner distances d_j it is at
-// most min_j (d_j + farthest corner from j) (crude bound), and at most d(c) + max_j |v_j - c| with
-// c the centroid (refined bound). Triangles whose bound could beat the best value found are
-// refined (centroid first, then split into four) in the order of their bound.
+// Upper bounds of the distance d to the target surface over a piece (a triangle of the source
+// surface or a part of one):
+//  - Lipschitz: d is 1-Lipschitz, so d <= d(v_j) + (farthest corner from v_j), and
+//    d <= d(c) + max_j |v_j - c| with c the centroid;
+//  - convex: d <= dist(., T) for any target triangle T, and dist(., T) is convex, so its maximum
+//    over the piece is at a corner: d <= max_j dist(v_j, T). With T the triangle closest to a
+//    corner or to the centroid this is tight where the piece faces one target triangle (e.g.
+//    parallel to it), where the Lipschitz bounds would need tiny pieces.
+// Pieces whose bound could exceed the best value found (plus the tolerance) are refined,
+// largest bound first: centroid first, then a split into four.
 struct Piece
 {
   Vec3 P[3];
   double D[3];
+  int Near[3];
   double Upper;
   int Cell;
   bool Refined;
 };
 
-double crudeBound(const Vec3 p[3], const double d[3])
+struct Target
 {
-  double u = kInf;
-  for (int j = 0; j < 3; ++j)
+  const TriangleTree& Tree;
+  const TriangleMesh& Mesh;
+
+  double convexBound(const Vec3 p[3], int triangle) const
   {
-    const double far = std::max((p[(j + 1) % 3] - p[j]).norm(), (p[(j + 2) % 3] - p[j]).norm());
-    u = std::min(u, d[j] + far);
+    if (triangle < 0)
+    {
+      return kInf;
+    }
+    const Triangle& t = Mesh.Triangles[triangle];
+    const Vec3 &a = Mesh.Points[t[0]], &b = Mesh.Points[t[1]], &c = Mesh.Points[t[2]];
+    double m = 0.0;
+    for (int j = 0; j < 3; ++j)
+    {
+      m = std::max(m, (p[j] - closestPointOnTriangle(p[j], a, b, c)).norm());
+    }
+    return m;
   }
-  return u;
-}
+  /// Lipschitz bound from the corners and convex bounds from the corners' closest triangles.
+  double bound(const Piece& piece) const
+  {
+    double u = kInf;
+    for (int j = 0; j < 3; ++j)
+    {
+      const double far = std::max((piece.P[(j + 1) % 3] - piece.P[j]).norm(), (piece.P[(j + 2) % 3] - piece.P[j]).norm());
+      u = std::min(u, piece.D[j] + far);
+    }
+    for (int j = 0; j < 3; ++j)
+    {
+      if (j == 0 || piece.Near[j] != piece.Near[j - 1])
+      {
+        u = std::min(u, this->convexBound(piece.P, piece.Near[j]));
+      }
+    }
+    return u;
+  }
+  double closest(const Vec3& p, int& triangle) const
+  {
+    Vec3 q;
+    double d = kInf;
+    triangle = -1;
+    Tree.closestPoint(p, -1.0, q, triangle, d);
+    return d;
+  }
+};
 
 struct PieceOrder
 {
@@ -152,8 +200,8 @@ struct HausdorffBounds
 };
 
 HausdorffBounds hausdorff(const TriangleMesh& from, const std::vector<double>& vertexDistance,
-  const TriangleTree& to, double lowerStart, double tolerance, long long budget, std::vector<double>* cellMax,
-  Progress* progress)
+  const std::vector<int>& vertexNear, const Target& to, double lowerStart, double tolerance, long long budget,
+  std::vector<double>* cellMax, Progress* progress)
 {
   double lower = lowerStart;
   for (const Triangle& t : from.Triangles)
@@ -163,20 +211,29 @@ HausdorffBounds hausdorff(const TriangleMesh& from, const std::vector<double>& v
       lower = std::max(lower, vertexDistance[t[k]]);
     }
   }
+  // initial pieces: every source triangle, bounded in parallel
+  const std::size_t nf = from.Triangles.size();
+  std::vector<Piece> initial(nf);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t f = r.begin(); f != r.end(); ++f)
+    {
+      const Triangle& t = from.Triangles[f];
+      Piece& piece = initial[f];
+      for (int k = 0; k < 3; ++k)
+      {
+        piece.P[k] = from.Points[t[k]];
+        piece.D[k] = vertexDistance[t[k]];
+        piece.Near[k] = vertexNear[t[k]];
+      }
+      piece.Cell = static_cast<int>(f);
+      piece.Refined = false;
+      piece.Upper = to.bound(piece);
+    }
+  });
   double discarded = lower; // largest bound of a piece dropped because it could not beat `lower`
   std::priority_queue<Piece, std::vector<Piece>, PieceOrder> heap;
-  for (std::size_t f = 0; f < from.Triangles.size(); ++f)
+  for (const Piece& piece : initial)
   {
-    const Triangle& t = from.Triangles[f];
-    Piece piece;
-    for (int k = 0; k < 3; ++k)
-    {
-      piece.P[k] = from.Points[t[k]];
-      piece.D[k] = vertexDistance[t[k]];
-    }
-    piece.Upper = crudeBound(piece.P, piece.D);
-    piece.Cell = static_cast<int>(f);
-    piece.Refined = false;
     if (piece.Upper > lower + tolerance)
     {
       heap.push(piece);
@@ -186,10 +243,13 @@ HausdorffBounds hausdorff(const TriangleMesh& from, const std::vector<double>& v
       discarded = std::max(discarded, piece.Upper);
     }
   }
+  initial.clear();
+  initial.shrink_to_fit();
+
   const std::size_t batchSize = 256;
-  std::vector<Piece> batch, produced;
+  std::vector<Piece> batch;
   std::vector<std::vector<Piece>> children;
-  std::vector<std::vector<double>> samples; // (cell-less) new point distances per batch entry
+  std::vector<std::vector<double>> samples; // new point distances per batch entry
   while (!heap.empty() && heap.top().Upper > lower + tolerance && budget > 0)
   {
     if (progressCancelled(progress))
@@ -211,14 +271,15 @@ HausdorffBounds hausdorff(const TriangleMesh& from, const std::vector<double>& v
         if (!piece.Refined)
         {
           const Vec3 c = (piece.P[0] + piece.P[1] + piece.P[2]) / 3.0;
-          const double dc = to.distance(c);
+          int nc = -1;
+          const double dc = to.closest(c, nc);
           double reach = 0.0;
           for (const Vec3& p : piece.P)
           {
             reach = std::max(reach, (p - c).norm());
           }
           Piece refined = piece;
-          refined.Upper = std::min(piece.Upper, dc + reach);
+          refined.Upper = std::min({ piece.Upper, dc + reach, to.convexBound(piece.P, nc) });
           refined.Refined = true;
           children[b].push_back(refined);
           samples[b].push_back(dc);
@@ -226,10 +287,11 @@ HausdorffBounds hausdorff(const TriangleMesh& from, const std::vector<double>& v
         }
         Vec3 m[3];
         double dm[3];
+        int nm[3];
         for (int k = 0; k < 3; ++k)
         {
           m[k] = 0.5 * (piece.P[k] + piece.P[(k + 1) % 3]);
-          dm[k] = to.distance(m[k]);
+          dm[k] = to.closest(m[k], nm[k]);
           samples[b].push_back(dm[k]);
         }
         // corners: 0, m0, m2 | m0, 1, m1 | m2, m1, 2 | m0, m1, m2
@@ -237,6 +299,8 @@ HausdorffBounds hausdorff(const TriangleMesh& from, const std::vector<double>& v
           { &m[2], &m[1], &piece.P[2] }, { &m[0], &m[1], &m[2] } };
         const double subD[4][3] = { { piece.D[0], dm[0], dm[2] }, { dm[0], piece.D[1], dm[1] },
           { dm[2], dm[1], piece.D[2] }, { dm[0], dm[1], dm[2] } };
+        const int subN[4][3] = { { piece.Near[0], nm[0], nm[2] }, { nm[0], piece.Near[1], nm[1] },
+          { nm[2], nm[1], piece.Near[2] }, { nm[0], nm[1], nm[2] } };
         for (int s = 0; s < 4; ++s)
         {
           Piece child;
@@ -244,10 +308,11 @@ HausdorffBounds hausdorff(const TriangleMesh& from, const std::vector<double>& v
           {
             child.P[k] = *sub[s][k];
             child.D[k] = subD[s][k];
+            child.Near[k] = subN[s][k];
           }
-          child.Upper = std::min(piece.Upper, crudeBound(child.P, child.D));
           child.Cell = piece.Cell;
           child.Refined = false;
+          child.Upper = std::min(piece.Upper, to.bound(child));
           children[b].push_back(child);
         }
       }
@@ -456,8 +521,9 @@ CageQualityResult evaluateCage(const TriangleMesh& inputMesh, const TriangleMesh
   progressStage(progress, "distances", 0.2, 0.4);
   const TriangleTree inputTree(input), cageTree(cage);
   const std::vector<char> cageUsed = referencedMask(cage);
-  const std::vector<double> cageDistance = pointDistances(cage, cageUsed, inputTree);
-  const std::vector<double> inputDistance = pointDistances(input, inputUsed, cageTree);
+  std::vector<int> cageNear, inputNear;
+  const std::vector<double> cageDistance = pointDistances(cage, cageUsed, inputTree, cageNear);
+  const std::vector<double> inputDistance = pointDistances(input, inputUsed, cageTree, inputNear);
   // every finite cage point gets its distance (unreferenced ones too: they are displayed)
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cageMesh.Points.size(), 512), [&](const tbb::blocked_range<std::size_t>& rg) {
     for (std::size_t i = rg.begin(); i != rg.end(); ++i)
@@ -704,7 +770,7 @@ CageQualityResult evaluateCage(const TriangleMesh& inputMesh, const TriangleMesh
   // --- Hausdorff distances (branch and bound) ---
   progressStage(progress, "Hausdorff cage to input", 0.8, 0.9);
   const double tol = options.HausdorffTolerance * r.Diagonal;
-  const HausdorffBounds hc = hausdorff(cage, cageDistance, inputTree, sampledMax, tol, options.HausdorffBudget, &cellMax, progress);
+  const HausdorffBounds hc = hausdorff(cage, cageDistance, cageNear, Target{ inputTree, input }, sampledMax, tol, options.HausdorffBudget, &cellMax, progress);
   r.HausdorffCageToInput = hc.Value;
   r.HausdorffCageToInputBound = hc.Bound;
   for (std::size_t f = 0; f < nf; ++f)
@@ -712,7 +778,7 @@ CageQualityResult evaluateCage(const TriangleMesh& inputMesh, const TriangleMesh
     r.CellDistance[cageKept[f]] = cellMax[f];
   }
   progressStage(progress, "Hausdorff input to cage", 0.9, 1.0);
-  const HausdorffBounds hi = hausdorff(input, inputDistance, cageTree, 0.0, tol, options.HausdorffBudget, nullptr, progress);
+  const HausdorffBounds hi = hausdorff(input, inputDistance, inputNear, Target{ cageTree, cage }, 0.0, tol, options.HausdorffBudget, nullptr, progress);
   r.HausdorffInputToCage = hi.Value;
   r.HausdorffInputToCageBound = hi.Bound;
   if (cancelled())
