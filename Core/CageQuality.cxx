@@ -390,6 +390,12 @@ CageQualityResult evaluateCage(const TriangleMesh& inputMesh, const TriangleMesh
 {
   const auto start = std::chrono::steady_clock::now();
   CageQualityResult r;
+  auto lapStart = start;
+  auto lap = [&](int phase) {
+    const auto now = std::chrono::steady_clock::now();
+    r.PhaseSeconds[phase] += std::chrono::duration<double>(now - lapStart).count();
+    lapStart = now;
+  };
   std::vector<std::string> reasons;
   auto finish = [&]() {
     std::string msg;
@@ -496,6 +502,7 @@ CageQualityResult evaluateCage(const TriangleMesh& inputMesh, const TriangleMesh
     return finish();
   }
 
+  lap(0);
   // --- self-intersections (degenerate triangles count once each, as CGAL reports them) ---
   progressStage(progress, "self-intersections", 0.1, 0.2);
   if (!cage.empty())
@@ -517,6 +524,7 @@ CageQualityResult evaluateCage(const TriangleMesh& inputMesh, const TriangleMesh
     return finish();
   }
 
+  lap(1);
   // --- point distances both ways ---
   progressStage(progress, "distances", 0.2, 0.4);
   const TriangleTree inputTree(input), cageTree(cage);
@@ -563,6 +571,7 @@ CageQualityResult evaluateCage(const TriangleMesh& inputMesh, const TriangleMesh
     return finish();
   }
 
+  lap(2);
   // --- exact minimum clearance: cage triangles in increasing order of a Lipschitz lower bound,
   // each measured exactly against the input only below the best value so far ---
   progressStage(progress, "clearance", 0.4, 0.6);
@@ -638,6 +647,7 @@ CageQualityResult evaluateCage(const TriangleMesh& inputMesh, const TriangleMesh
       " cage/input triangle pairs)");
   }
 
+  lap(3);
   // --- input vertices inside: the winding number is constant along every input edge that cannot
   // reach the cage (d(u) + d(v) > |u - v|, the distance being 1-Lipschitz), so it is evaluated
   // once per group of vertices connected by such edges, at the vertex farthest from the cage ---
@@ -713,6 +723,7 @@ CageQualityResult evaluateCage(const TriangleMesh& inputMesh, const TriangleMesh
     return finish();
   }
 
+  lap(4);
   // --- mean distance over the cage (midpoint rule on 4^level sub-triangles per triangle, the level
   // chosen per triangle from its size) ---
   progressStage(progress, "mean distance", 0.7, 0.8);
@@ -767,6 +778,7 @@ CageQualityResult evaluateCage(const TriangleMesh& inputMesh, const TriangleMesh
     return finish();
   }
 
+  lap(5);
   // --- Hausdorff distances (branch and bound) ---
   progressStage(progress, "Hausdorff cage to input", 0.8, 0.9);
   const double tol = options.HausdorffTolerance * r.Diagonal;
@@ -786,6 +798,7 @@ CageQualityResult evaluateCage(const TriangleMesh& inputMesh, const TriangleMesh
     return finish();
   }
 
+  lap(6);
   r.Encloses = reasons.empty() && r.SelfIntersections == 0 && r.InputIntersections == 0 && r.InputVerticesOutside == 0 &&
     r.MinimumClearance > 0.0;
   return finish();

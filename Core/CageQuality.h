@@ -98,6 +98,11 @@ struct CageQualityResult
   long long InputInvalidTriangles = 0;
 
   double Seconds = 0.0;
+  /// Wall time of the phases: topology and shape, self-intersections, point distances both
+  /// ways, exact clearance (and intersecting pairs), inside test, mean distance, Hausdorff.
+  double PhaseSeconds[7] = { 0, 0, 0, 0, 0, 0, 0 };
+  static constexpr const char* PhaseNames[7] = { "topology", "self-intersections", "point distances",
+    "clearance", "inside test", "mean distance", "Hausdorff" };
 };
 
 /// Judges `cage` against `input` (same coordinates). Never throws on bad meshes: an empty or
