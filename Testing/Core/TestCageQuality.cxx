@@ -3,6 +3,7 @@
 // against brute force.
 #include "CageQuality.h"
 #include "ExactCheck.h"
+#include "MeshIO.h"
 #include "Geometry.h"
 #include "Mesh.h"
 #include "Progress.h"
@@ -342,4 +343,98 @@ TEST(CageQuality, CancelReturnsEarly)
   const CageQualityResult q = evaluateCage(unitSphere(), cube(1.5), CageQualityOptions(), &progress);
   EXPECT_FALSE(q.Encloses);
   EXPECT_EQ(q.Message, "cancelled");
+}
+
+namespace
+{
+/// A tetrahedron (closed, outward) with corners a, b, c, d (d above the plane of a, b, c).
+TriangleMesh tetrahedron(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d)
+{
+  TriangleMesh m;
+  m.Points = { a, b, c, d };
+  m.Triangles = { { 0, 2, 1 }, { 0, 1, 3 }, { 1, 2, 3 }, { 2, 0, 3 } };
+  if (signedVolume(m) < 0)
+  {
+    for (Triangle& t : m.Triangles)
+    {
+      std::swap(t[1], t[2]);
+    }
+  }
+  return m;
+}
+} // namespace
+
+TEST(CageQuality, VertexExactlyOnAnInputEdgeTouches)
+{
+  // input: a tetrahedron; (0.5, 1, 1.5) lies exactly (in binary too) on its edge (0,0,0)-(1,2,3)
+  const TriangleMesh input = tetrahedron(Vec3(0, 0, 0), Vec3(2, 0, 0), Vec3(0, 2, 0), Vec3(1, 2, 3));
+  const Vec3 m(0.5, 1.0, 1.5);
+  // away from the edge, perpendicular to it, away from the input's centroid
+  const Vec3 d = Vec3(1, 2, 3).normalized();
+  Vec3 u = m - Vec3(0.75, 1.0, 0.75);
+  u = (u - u.dot(d) * d).normalized();
+  auto cageWithApex = [&](const Vec3& apex) {
+    return tetrahedron(apex, apex + 3.0 * u + Vec3(0.3, 0, 0), apex + 3.0 * u + Vec3(0, 0.3, 0),
+      apex + 3.0 * u + Vec3(0, 0, 0.3));
+  };
+  // touching: not enclosing, clearance 0, the touching pairs counted; CGAL agrees
+  const TriangleMesh touching = cageWithApex(m);
+  const CageQualityResult q = evaluateCage(input, touching);
+  EXPECT_EQ(q.MinimumClearance, 0.0);
+  EXPECT_GT(q.InputIntersections, 0);
+  const exact::ExactReport e = exact::exactCheck(input, touching, 0.0);
+  EXPECT_GT(e.InputIntersections, 0);
+  EXPECT_FALSE(q.Encloses);
+  EXPECT_FALSE(e.Encloses);
+
+  // 1e-6 of the diagonal away: no intersection, clearance about that gap (CGAL agrees)
+  const double gap = 1e-6 * diagonal(input);
+  const TriangleMesh near = cageWithApex(m + gap * u);
+  const CageQualityResult qn = evaluateCage(input, near);
+  EXPECT_EQ(qn.InputIntersections, 0);
+  EXPECT_GT(qn.MinimumClearance, 0.5 * gap);
+  EXPECT_LE(qn.MinimumClearance, gap * (1 + 1e-6));
+  const exact::ExactReport en = exact::exactCheck(input, near, 0.0);
+  EXPECT_EQ(en.InputIntersections, 0);
+  EXPECT_NEAR(qn.MinimumClearance, en.MinimumClearance, 1e-12 * qn.Diagonal);
+}
+
+TEST(CageQuality, RealMeshScaledCopiesAgreeWithExact)
+{
+  const std::string path = std::string(SDFCAGE_DATA_DIR) + "/bunny.off";
+  PolygonMesh polygons;
+  std::string error;
+  if (!exact::readPolygonMesh(path, polygons, error))
+  {
+    GTEST_SKIP() << "no data: " << error;
+  }
+  TriangleMesh bunny;
+  exact::fanTriangulate(polygons, bunny);
+  const auto box = bounds(bunny);
+  const Vec3 centre = 0.5 * (box[0] + box[1]);
+  // scaled copies about the box centre: the bunny is not star-shaped, so the larger copies may
+  // or may not enclose it; whatever the verdict, CGAL's exact predicates must agree
+  for (double scale : { 0.97, 1.0, 1.03, 1.2 })
+  {
+    TriangleMesh cage = bunny;
+    // (scale 1 keeps the points bit for bit: centre + (p - centre) may move them by an ulp, and
+    // an ulp is "touching" for evaluateCage (1e-12 of the diagonal) but not for CGAL)
+    for (Vec3& p : cage.Points)
+    {
+      p = scale == 1.0 ? p : Vec3(centre + scale * (p - centre));
+    }
+    const CageQualityResult q = evaluateCage(bunny, cage);
+    SCOPED_TRACE("scale " + std::to_string(scale) + ": " + q.Message);
+    if (scale <= 1.0)
+    {
+      EXPECT_FALSE(q.Encloses);
+    }
+    if (scale == 1.0)
+    {
+      EXPECT_EQ(q.MinimumClearance, 0.0); // the same surface: touches everywhere
+      EXPECT_EQ(q.InputVerticesOutside, q.InputVertices);
+    }
+    EXPECT_EQ(q.CageGenus, q.InputGenus);
+    expectAgreesWithExact(bunny, cage, q);
+  }
 }
