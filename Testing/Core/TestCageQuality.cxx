@@ -10,6 +10,7 @@
 #include "Shapes.h"
 
 #include <gtest/gtest.h>
+#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <cmath>
@@ -437,4 +438,27 @@ TEST(CageQuality, RealMeshScaledCopiesAgreeWithExact)
     EXPECT_EQ(q.CageGenus, q.InputGenus);
     expectAgreesWithExact(bunny, cage, q);
   }
+}
+
+TEST(CageQuality, SameResultsWithOneThread)
+{
+  const TriangleMesh torus = makeTorus(Vec3::Zero(), 1.0, 0.3, 64, 24);
+  TriangleMesh cage = makeSphere(Vec3(0.1, 0.0, 0.05), 1.45, 12, 8);
+  const CageQualityResult many = evaluateCage(torus, cage);
+  CageQualityResult one;
+  {
+    tbb::global_control single(tbb::global_control::max_allowed_parallelism, 1);
+    one = evaluateCage(torus, cage);
+  }
+  EXPECT_EQ(many.Encloses, one.Encloses);
+  EXPECT_EQ(many.MinimumClearance, one.MinimumClearance);
+  EXPECT_EQ(many.HausdorffCageToInput, one.HausdorffCageToInput);
+  EXPECT_EQ(many.HausdorffCageToInputBound, one.HausdorffCageToInputBound);
+  EXPECT_EQ(many.HausdorffInputToCage, one.HausdorffInputToCage);
+  EXPECT_EQ(many.HausdorffInputToCageBound, one.HausdorffInputToCageBound);
+  EXPECT_EQ(many.MeanDistanceCageToInput, one.MeanDistanceCageToInput);
+  EXPECT_EQ(many.InputVerticesOutside, one.InputVerticesOutside);
+  EXPECT_EQ(many.InputIntersections, one.InputIntersections);
+  EXPECT_EQ(many.CellDistance, one.CellDistance);
+  EXPECT_EQ(many.PointDistance, one.PointDistance);
 }
