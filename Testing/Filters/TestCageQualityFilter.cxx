@@ -19,6 +19,7 @@
 #include "vtkPolyData.h"
 #include "vtkSphereSource.h"
 #include "vtkStringArray.h"
+#include "vtkStripper.h"
 #include "vtkTriangleFilter.h"
 
 #include <cmath>
@@ -226,6 +227,57 @@ int TestQualityOfSDFCage(const Context&)
   return c.Result();
 }
 
+int TestQualityMixedCells(const Context&)
+{
+  Checker c("QualityMixedCells");
+  // the closed cube of quads plus a vertex cell and a line cell (ignored, NaN cell values), and
+  // the same cube as triangle strips: the verdict and the per-cell values follow the cells
+  auto cube = Cube(3.0, true);
+  vtkNew<vtkCellArray> verts, lines;
+  const vtkIdType v0 = 0, l01[2] = { 0, 1 };
+  verts->InsertNextCell(1, &v0);
+  lines->InsertNextCell(2, l01);
+  cube->SetVerts(verts);
+  cube->SetLines(lines);
+  vtkNew<vtkCageQualityFilter> quality;
+  quality->SetInputData(cube);
+  quality->SetSourceData(Sphere(1.0, 32));
+  quality->Update();
+  vtkPolyData* out = quality->GetOutput();
+  c.Check(quality->GetEncloses(), std::string("quads + vertex + line cells still enclose: ") + quality->GetQualityMessage());
+  c.Check(out->GetNumberOfCells() == 8, "8 cells (1 vertex, 1 line, 6 quads): " + Str(out->GetNumberOfCells()));
+  vtkDataArray* angle = out->GetCellData()->GetArray("MinimumAngle");
+  vtkDataArray* distance = out->GetCellData()->GetArray("DistanceToInput");
+  c.Check(angle && angle->GetNumberOfTuples() == 8 && distance && distance->GetNumberOfTuples() == 8, "8 cell values");
+  if (angle && distance)
+  {
+    c.Check(std::isnan(angle->GetTuple1(0)) && std::isnan(angle->GetTuple1(1)), "vertex and line cells: NaN");
+    bool quadsOk = true;
+    for (vtkIdType i = 2; i < 8; ++i)
+    {
+      quadsOk = quadsOk && std::abs(angle->GetTuple1(i) - 45.0) < 1e-9 && distance->GetTuple1(i) > 0.5;
+    }
+    c.Check(quadsOk, "every quad: minimum angle 45, distance > 0.5");
+  }
+
+  vtkNew<vtkTriangleFilter> triangles;
+  triangles->SetInputData(Cube(3.0, true));
+  vtkNew<vtkStripper> stripper;
+  stripper->SetInputConnection(triangles->GetOutputPort());
+  stripper->Update();
+  vtkPolyData* strips = stripper->GetOutput();
+  c.Check(strips->GetNumberOfStrips() > 0 && strips->GetNumberOfPolys() == 0, "the cube as triangle strips");
+  quality->SetInputData(strips);
+  quality->Update();
+  c.Check(quality->GetEncloses(), std::string("the strips enclose too: ") + quality->GetQualityMessage());
+  c.Check(quality->GetCageGenus() == 0, "genus 0 from strips");
+  vtkDataArray* stripAngle = quality->GetOutput()->GetCellData()->GetArray("MinimumAngle");
+  c.Check(stripAngle && stripAngle->GetNumberOfTuples() == strips->GetNumberOfCells() &&
+      std::abs(stripAngle->GetRange()[0] - 45.0) < 1e-9,
+    "one value per strip, 45 degrees");
+  return c.Result();
+}
+
 int TestQualityAbort(const Context&)
 {
   Checker c("QualityAbort");
@@ -253,6 +305,7 @@ int main(int argc, char* argv[])
     { "QualityBrokenCages", TestQualityBrokenCages },
     { "QualityOfSDFCage", TestQualityOfSDFCage },
     { "QualityAbort", TestQualityAbort },
+    { "QualityMixedCells", TestQualityMixedCells },
   };
   if (argc < 2 || cases.find(argv[1]) == cases.end())
   {
