@@ -15,12 +15,15 @@ class Progress;
 
 struct CageQualityOptions
 {
-  /// Two surfaces closer than TouchingTolerance x (bounding-box diagonal) count as touching. The
-  /// distance formulas (Geometry.h) return 0 for crossing triangles and are exact up to
-  /// double-precision rounding, about 1e-16 x the coordinates, otherwise: 1e-12 separates
-  /// "touching" (a computed distance that is rounding noise) from any real clearance by four
-  /// orders of magnitude, so a cage with clearance 1e-6 x diagonal is judged exactly.
-  double TouchingTolerance = 1e-12;
+  /// Two triangles closer than TouchingTolerance x D count as touching (D: the larger of the
+  /// input's and the cage's bounding-box diagonals). The distance formulas of Geometry.h return
+  /// 0 for triangles whose edges cross cleanly and are exact up to double rounding (about 1e-16
+  /// x the coordinates) otherwise; but a crossing whose edge endpoint lies within 1e-10 (relative
+  /// to the edge) of the other triangle's plane is left to those distances, which then come out
+  /// as (at most about) that depth. 1e-10 therefore counts such crossings as touching and still
+  /// separates touching from any real clearance: a cage with clearance 1e-6 x diagonal is judged
+  /// by four orders of magnitude.
+  double TouchingTolerance = 1e-10;
   /// The Hausdorff distances are certified by branch and bound to within this absolute gap
   /// (relative to the input's bounding-box diagonal) unless the evaluation budget runs out; the
   /// bounds actually reached are reported either way.
@@ -44,7 +47,7 @@ struct CageQualityOptions
 /// (SelfIntersections == 0); no cage triangle intersects or touches an input triangle
 /// (InputIntersections == 0); and every input vertex is strictly inside the cage (its winding
 /// number is odd, and it does not lie on the cage). Touching means a computed distance <=
-/// TouchingTolerance x diagonal. Then MinimumClearance > 0 is the exact distance between the
+/// TouchingTolerance x D (see CageQualityOptions). Then MinimumClearance > 0 is the exact distance between the
 /// two surfaces. Orientation (inward or outward) is reported but not required.
 struct CageQualityResult
 {

@@ -29,9 +29,10 @@
  * Encloses is exact in effect, never sampled: the cage is a closed, consistently oriented
  * 2-manifold without degenerate triangles, no two non-adjacent cage triangles intersect or touch,
  * no cage triangle intersects or touches an input triangle, and every input vertex is strictly
- * inside (odd winding number). Touching means a computed triangle–triangle distance below 1e-12 of
- * the input's diagonal (rounding noise of the double-precision distance formulas), so a cage
- * that keeps 1e-6 of the diagonal is judged enclosing and one that touches is not. The
+ * inside (odd winding number). Touching means a computed triangle–triangle distance below 1e-10 of
+ * the larger bounding-box diagonal (what the double-precision predicates of Core cannot tell
+ * from contact), so a cage that keeps 1e-6 of the diagonal is judged enclosing and one that
+ * touches is not. The
  * Hausdorff distances are found by branch and bound over the surfaces (the distance is
  * 1-Lipschitz) to within 1e-4 of the diagonal; the mean distance is a quadrature (16 points per
  * cage triangle).

@@ -419,7 +419,7 @@ TEST(CageQuality, RealMeshScaledCopiesAgreeWithExact)
   {
     TriangleMesh cage = bunny;
     // (scale 1 keeps the points bit for bit: centre + (p - centre) may move them by an ulp, and
-    // an ulp is "touching" for evaluateCage (1e-12 of the diagonal) but not for CGAL)
+    // an ulp is "touching" for evaluateCage (1e-10 of the diagonal) but not for CGAL)
     for (Vec3& p : cage.Points)
     {
       p = scale == 1.0 ? p : Vec3(centre + scale * (p - centre));
@@ -461,4 +461,19 @@ TEST(CageQuality, SameResultsWithOneThread)
   EXPECT_EQ(many.InputIntersections, one.InputIntersections);
   EXPECT_EQ(many.CellDistance, one.CellDistance);
   EXPECT_EQ(many.PointDistance, one.PointDistance);
+}
+
+TEST(CageQuality, ShallowCrossingCountsAsTouching)
+{
+  // The input's top face lies in z = 0; the cage's apex pokes 1e-11 below it (inside the input):
+  // a crossing too shallow for the orientation test, which the distances then report as ~1e-11.
+  // It must count as an intersection (CGAL: it crosses).
+  const TriangleMesh input = tetrahedron(Vec3(0, 0, 0), Vec3(2, 0, 0), Vec3(0, 2, 0), Vec3(0.5, 0.5, -1));
+  const Vec3 apex(0.5, 0.5, -1e-11);
+  const TriangleMesh cage = tetrahedron(apex, Vec3(0, 0, 3), Vec3(1, 0, 3), Vec3(0, 1, 3));
+  const CageQualityResult q = evaluateCage(input, cage);
+  EXPECT_EQ(q.MinimumClearance, 0.0);
+  EXPECT_GT(q.InputIntersections, 0);
+  const exact::ExactReport e = exact::exactCheck(input, cage, 0.0);
+  EXPECT_GT(e.InputIntersections, 0);
 }
