@@ -8,6 +8,7 @@
 #include "Validation.h"
 
 #include <tbb/blocked_range.h>
+#include <tbb/parallel_invoke.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
@@ -481,15 +482,33 @@ CageQualityResult evaluateCage(const TriangleMesh& inputMesh, const TriangleMesh
   progressStage(progress, "topology", 0.0, 0.1);
   const std::vector<char> inputUsed = referencedMask(input);
   r.InputVertices = std::count(inputUsed.begin(), inputUsed.end(), 1);
-  if (!input.empty())
-  {
-    const MeshDefects di = checkTriangleMesh(input);
-    r.InputClosedManifold = di.BoundaryEdges == 0 && di.NonManifoldEdges == 0 && di.NonManifoldVertices == 0;
-    r.InputGenus = r.InputClosedManifold ? genus(input) : -1;
-  }
+  // the input's topology and the two search trees are independent: build them concurrently
+  TriangleTree inputTree, cageTree;
+  MeshDefects di, dc;
+  tbb::parallel_invoke(
+    [&]() {
+      if (!input.empty())
+      {
+        di = checkTriangleMesh(input);
+        r.InputClosedManifold = di.BoundaryEdges == 0 && di.NonManifoldEdges == 0 && di.NonManifoldVertices == 0;
+        r.InputGenus = !r.InputClosedManifold ? -1 : di.usable() ? di.Genus : genus(input);
+      }
+    },
+    [&]() {
+      if (!input.empty() && !cage.empty())
+      {
+        inputTree.build(input);
+      }
+    },
+    [&]() {
+      if (!cage.empty())
+      {
+        dc = checkTriangleMesh(cage);
+        cageTree.build(cage);
+      }
+    });
   if (!cage.empty())
   {
-    const MeshDefects dc = checkTriangleMesh(cage);
     r.BoundaryEdges = dc.BoundaryEdges;
     r.NonManifoldEdges = dc.NonManifoldEdges;
     r.NonManifoldVertices = dc.NonManifoldVertices;
@@ -497,7 +516,7 @@ CageQualityResult evaluateCage(const TriangleMesh& inputMesh, const TriangleMesh
     r.InconsistentEdges = dc.InconsistentEdges;
     r.CageComponents = dc.Components;
     r.CageClosedManifold = dc.BoundaryEdges == 0 && dc.NonManifoldEdges == 0 && dc.NonManifoldVertices == 0;
-    r.CageGenus = r.CageClosedManifold ? genus(cage) : -1;
+    r.CageGenus = !r.CageClosedManifold ? -1 : dc.usable() ? dc.Genus : genus(cage);
     r.CageInwardOriented = r.CageClosedManifold && r.InconsistentEdges == 0 && signedVolume(cage) < 0;
   }
 
@@ -574,7 +593,6 @@ CageQualityResult evaluateCage(const TriangleMesh& inputMesh, const TriangleMesh
   lap(1);
   // --- point distances both ways ---
   progressStage(progress, "distances", 0.2, 0.4);
-  const TriangleTree inputTree(input), cageTree(cage);
   const std::vector<char> cageUsed = referencedMask(cage);
   std::vector<int> cageNear, inputNear;
   const std::vector<double> cageDistance = pointDistances(cage, cageUsed, inputTree, cageNear);
