@@ -253,40 +253,43 @@ HausdorffBounds hausdorff(const TriangleMesh& from, const std::vector<double>& v
       lower = std::max(lower, vertexDistance[t[k]]);
     }
   }
-  // initial pieces: every source triangle, bounded in parallel
+  // initial pieces: every source triangle, bounded in parallel; only those that could beat the
+  // best value found are kept
   const std::size_t nf = from.Triangles.size();
-  std::vector<Piece> initial(nf);
+  auto makePiece = [&](std::size_t f) {
+    const Triangle& t = from.Triangles[f];
+    Piece piece;
+    for (int k = 0; k < 3; ++k)
+    {
+      piece.P[k] = from.Points[t[k]];
+      piece.D[k] = vertexDistance[t[k]];
+      piece.Near[k] = vertexNear[t[k]];
+    }
+    piece.Cell = static_cast<int>(f);
+    piece.Refined = false;
+    piece.Upper = to.bound(piece);
+    return piece;
+  };
+  std::vector<double> initialUpper(nf);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t f = r.begin(); f != r.end(); ++f)
     {
-      const Triangle& t = from.Triangles[f];
-      Piece& piece = initial[f];
-      for (int k = 0; k < 3; ++k)
-      {
-        piece.P[k] = from.Points[t[k]];
-        piece.D[k] = vertexDistance[t[k]];
-        piece.Near[k] = vertexNear[t[k]];
-      }
-      piece.Cell = static_cast<int>(f);
-      piece.Refined = false;
-      piece.Upper = to.bound(piece);
+      initialUpper[f] = makePiece(f).Upper;
     }
   });
   double discarded = lower; // largest bound of a piece dropped because it could not beat `lower`
   std::priority_queue<Piece, std::vector<Piece>, PieceOrder> heap;
-  for (const Piece& piece : initial)
+  for (std::size_t f = 0; f < nf; ++f)
   {
-    if (piece.Upper > lower + tolerance)
+    if (initialUpper[f] > lower + tolerance)
     {
-      heap.push(piece);
+      heap.push(makePiece(f));
     }
     else
     {
-      discarded = std::max(discarded, piece.Upper);
+      discarded = std::max(discarded, initialUpper[f]);
     }
   }
-  initial.clear();
-  initial.shrink_to_fit();
 
   const std::size_t batchSize = 256;
   std::vector<Piece> batch;
