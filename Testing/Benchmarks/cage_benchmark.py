@@ -2,7 +2,7 @@
 
     /usr/bin/python3 Testing/Benchmarks/cage_benchmark.py [MESH|FOLDER ...] [--builtin]
         [--vertices 200 500 1000] [--out benchmark] [--sdfcage build/bin/sdfcage]
-        [--timeout SECONDS] [--no-plots] [--no-gallery]
+        [--timeout SECONDS] [--no-plots] [--no-gallery] [--replot]
 
 Default: every mesh of ../shared/data (next to the source tree). For each mesh and each vertex
 count it runs `sdfcage MESH -n N` (its own process: peak memory is per run), then
@@ -17,7 +17,8 @@ count it runs `sdfcage MESH -n N` (its own process: peak memory is per run), the
 - gallery/<mesh>.png: the input and its largest cage (VTK offscreen; needs an X server, e.g.
   run the script under `xvfb-run -a`).
 
-Meshes the program rejects (open, non-manifold, ...) appear with their exit code and status.
+--replot redraws the plots and the gallery from an earlier run's output folder (results.csv and
+cages/) without computing anything. Meshes the program rejects (open, non-manifold, ...) appear with their exit code and status.
 Optimization (paper section 3.3) is not part of this build, so there is no "with optimization"
 column yet.
 """
@@ -149,11 +150,12 @@ def make_plots(rows, distances, out):
             sel = [r for r in ok if r["target"] == n]
             x = numpy.array([r["faces"] for r in sel], dtype=float)
             y = numpy.array([r["t_total"] for r in sel], dtype=float)
-            ax.loglog(x, y, "o", label="N = %d" % n)
+            points, = ax.loglog(x, y, "o", label="N = %d" % n)
             if len(sel) >= 2 and len(set(x)) >= 2:
                 slope, intercept = numpy.polyfit(numpy.log(x), numpy.log(y), 1)
                 xs = numpy.linspace(x.min(), x.max(), 20)
-                ax.loglog(xs, numpy.exp(intercept) * xs ** slope, "-", alpha=0.5)
+                ax.loglog(xs, numpy.exp(intercept) * xs ** slope, "-", alpha=0.5,
+                          color=points.get_color())
                 title.append("N=%d: t ~ F^%.2f" % (n, slope))
         ax.set_xlabel("input faces F")
         ax.set_ylabel("total time (s)")
@@ -228,6 +230,28 @@ def gallery(mesh_path, cage_path, png):
     return True
 
 
+def write_tables(rows, out):
+    with open(os.path.join(out, "results.csv"), "w", newline="") as f:
+        writer = csv.writer(f)
+        writer.writerow([key for key, _ in COLUMNS])
+        for row in rows:
+            writer.writerow([row.get(key, "") if row.get(key) is not None else "" for key, _ in COLUMNS])
+    cpu = "unknown CPU"
+    try:
+        with open("/proc/cpuinfo") as f:
+            cpu = next(l.split(":", 1)[1].strip() for l in f if l.startswith("model name"))
+    except (OSError, StopIteration):
+        pass
+    with open(os.path.join(out, "results.md"), "w") as f:
+        f.write("Machine: %s, %d cores, %s; %s. Distances relative to the input's bounding-box "
+                "diagonal; times in seconds.\n\n" % (cpu, os.cpu_count() or 0, platform.platform(),
+                                                      datetime.date.today().isoformat()))
+        f.write("| " + " | ".join(title for _, title in COLUMNS) + " |\n")
+        f.write("|" + "---|" * len(COLUMNS) + "\n")
+        for row in rows:
+            f.write("| " + " | ".join(fmt(row.get(key)) for key, _ in COLUMNS) + " |\n")
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("inputs", nargs="*", help="meshes or folders (default: ../shared/data)")
@@ -238,6 +262,7 @@ def main():
     parser.add_argument("--timeout", type=float, default=1800, help="seconds per cage run")
     parser.add_argument("--no-plots", action="store_true")
     parser.add_argument("--no-gallery", action="store_true")
+    parser.add_argument("--replot", action="store_true", help="only redraw plots and gallery")
     args = parser.parse_args()
 
     inputs = args.inputs
@@ -251,7 +276,25 @@ def main():
         os.makedirs(os.path.join(args.out, sub), exist_ok=True)
 
     rows, distances = [], {}
-    for mesh in meshes:
+    if args.replot:
+        with open(os.path.join(args.out, "results.csv")) as f:
+            for row in csv.DictReader(f):
+                for key in row:
+                    try:
+                        row[key] = int(row[key])
+                    except ValueError:
+                        try:
+                            row[key] = float(row[key])
+                        except ValueError:
+                            pass
+                rows.append(row)
+        for row in rows:
+            cage = os.path.join(args.out, "cages", "%s_%d.vtp" % (row["mesh"], row["target"]))
+            if row.get("exit") == 0 and os.path.isfile(cage):
+                distances[(row["mesh"], row["target"])] = cage_distances(cage)
+        meshes = [m for m in meshes if m == "builtin" or
+                  os.path.splitext(os.path.basename(m))[0] in {r["mesh"] for r in rows}]
+    for mesh in ([] if args.replot else meshes):
         stem = "builtin" if mesh == "builtin" else os.path.splitext(os.path.basename(mesh))[0]
         for n in args.vertices:
             cage = os.path.join(args.out, "cages", "%s_%d.vtp" % (stem, n))
@@ -289,25 +332,8 @@ def main():
             print("%-22s N=%-5d exit %d  %6.1f s  %7.1f MB  encloses %s" % (
                 stem, n, code, seconds, peak, fmt(row["encloses"])), flush=True)
 
-    with open(os.path.join(args.out, "results.csv"), "w", newline="") as f:
-        writer = csv.writer(f)
-        writer.writerow([key for key, _ in COLUMNS])
-        for row in rows:
-            writer.writerow([row.get(key, "") if row.get(key) is not None else "" for key, _ in COLUMNS])
-    cpu = "unknown CPU"
-    try:
-        with open("/proc/cpuinfo") as f:
-            cpu = next(l.split(":", 1)[1].strip() for l in f if l.startswith("model name"))
-    except (OSError, StopIteration):
-        pass
-    with open(os.path.join(args.out, "results.md"), "w") as f:
-        f.write("Machine: %s, %d cores, %s; %s. Distances relative to the input's bounding-box "
-                "diagonal; times in seconds.\n\n" % (cpu, os.cpu_count() or 0, platform.platform(),
-                                                      datetime.date.today().isoformat()))
-        f.write("| " + " | ".join(title for _, title in COLUMNS) + " |\n")
-        f.write("|" + "---|" * len(COLUMNS) + "\n")
-        for row in rows:
-            f.write("| " + " | ".join(fmt(row.get(key)) for key, _ in COLUMNS) + " |\n")
+    if not args.replot:
+        write_tables(rows, args.out)
 
     written = [] if args.no_plots else make_plots(rows, distances, args.out)
     if not args.no_gallery:
