@@ -9,6 +9,7 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_invoke.h>
+#include <tbb/task_group.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
@@ -442,7 +443,11 @@ CageQualityResult evaluateCage(const TriangleMesh& inputMesh, const TriangleMesh
     lapStart = now;
   };
   std::vector<std::string> reasons;
+  // the input's topology (closedness, genus) is needed only for the report: it runs beside
+  // everything else and is waited for at the end
+  tbb::task_group inputTopology;
   auto finish = [&]() {
+    inputTopology.wait();
     std::string msg;
     for (const std::string& s : reasons)
     {
@@ -487,16 +492,16 @@ CageQualityResult evaluateCage(const TriangleMesh& inputMesh, const TriangleMesh
   r.InputVertices = std::count(inputUsed.begin(), inputUsed.end(), 1);
   // the input's topology and the two search trees are independent: build them concurrently
   TriangleTree inputTree, cageTree;
-  MeshDefects di, dc;
+  MeshDefects dc;
+  if (!input.empty())
+  {
+    inputTopology.run([&]() {
+      const MeshDefects di = checkTriangleMesh(input);
+      r.InputClosedManifold = di.BoundaryEdges == 0 && di.NonManifoldEdges == 0 && di.NonManifoldVertices == 0;
+      r.InputGenus = !r.InputClosedManifold ? -1 : di.usable() ? di.Genus : genus(input);
+    });
+  }
   tbb::parallel_invoke(
-    [&]() {
-      if (!input.empty())
-      {
-        di = checkTriangleMesh(input);
-        r.InputClosedManifold = di.BoundaryEdges == 0 && di.NonManifoldEdges == 0 && di.NonManifoldVertices == 0;
-        r.InputGenus = !r.InputClosedManifold ? -1 : di.usable() ? di.Genus : genus(input);
-      }
-    },
     [&]() {
       if (!input.empty() && !cage.empty())
       {

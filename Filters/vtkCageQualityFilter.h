@@ -15,7 +15,7 @@
  * enclose. The output is the cage with
  * - point array `DistanceToInput`: exact distance of each cage point to the input;
  * - cell arrays `DistanceToInput` (the largest distance to the input found on the cell: its
- *   corners, 16 quadrature points and the samples of the Hausdorff search), `MinimumAngle`
+ *   corners, at least 16 quadrature points and the Hausdorff search samples), `MinimumAngle`
  *   (degrees) and `MIPSEnergy` (the MIPS energy of "High-quality Cage Generation Based on SDF",
  *   eq. 8, against an equilateral reference: 2 for an equilateral triangle, +inf degenerate);
  * - field data (one-tuple arrays, named like the getters): `Encloses` (0/1), `MinimumClearance`,
@@ -34,8 +34,8 @@
  * from contact), so a cage that keeps 1e-6 of the diagonal is judged enclosing and one that
  * touches is not. The
  * Hausdorff distances are found by branch and bound over the surfaces (the distance is
- * 1-Lipschitz) to within 1e-4 of the diagonal; the mean distance is a quadrature (16 points per
- * cage triangle).
+ * 1-Lipschitz) to within 1e-4 of the diagonal; the mean distance is a midpoint-rule quadrature
+ * (at least 16 points per cage triangle, sub-triangles of at most 2% of the diagonal).
  *
  * The work is done by SDFCage::Core (sdfcage::evaluateCage) with TBB threads; results do not
  * depend on the number of threads. GetAbortExecute() stops at the next phase with an empty
