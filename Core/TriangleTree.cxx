@@ -243,4 +243,38 @@ bool TriangleTree::anyCloserThan(const Vec3 t[3], double delta) const
   return this->triangleQuery(t, delta, true) < delta;
 }
 
+long long TriangleTree::countWithin(const Vec3 t[3], double delta) const
+{
+  if (Nodes.empty())
+  {
+    return 0;
+  }
+  const Vec3 tlo = t[0].cwiseMin(t[1]).cwiseMin(t[2]);
+  const Vec3 thi = t[0].cwiseMax(t[1]).cwiseMax(t[2]);
+  long long count = 0;
+  int stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top)
+  {
+    const Node& n = Nodes[stack[--top]];
+    if (boxBoxDistance2(n.Lo, n.Hi, tlo, thi) > delta * delta)
+    {
+      continue;
+    }
+    if (n.Left >= 0)
+    {
+      stack[top++] = n.Left;
+      stack[top++] = n.Right;
+      continue;
+    }
+    for (int i = n.Start; i < n.Start + n.Count; ++i)
+    {
+      const double d2 = triangleTriangleDistance2(t, Tri[i].P);
+      count += (d2 == 0.0 || d2 <= delta * delta) ? 1 : 0;
+    }
+  }
+  return count;
+}
+
 } // namespace sdfcage

@@ -25,6 +25,9 @@ public:
   double triangleDistance(const Vec3 t[3], double limit) const;
   /// True when some mesh triangle comes closer than `delta` to triangle t (stops at the first).
   bool anyCloserThan(const Vec3 t[3], double delta) const;
+  /// Number of mesh triangles at distance <= delta from triangle t (0 counts: intersecting or
+  /// touching). Used to count intersecting pairs.
+  long long countWithin(const Vec3 t[3], double delta) const;
 
   /// Unit normal of mesh triangle `id` (zero for degenerate triangles).
   const Vec3& normal(int id) const { return Normals[id]; }

@@ -9,9 +9,6 @@
 namespace sdfcage_cli
 {
 
-namespace
-{
-
 std::string jsonString(const std::string& s)
 {
   std::string out = "\"";
@@ -61,6 +58,9 @@ std::string jsonNumber(double v)
   std::snprintf(buffer, sizeof(buffer), "%.10g", v);
   return buffer;
 }
+
+namespace
+{
 
 std::string seconds(double s)
 {

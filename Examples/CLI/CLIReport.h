@@ -69,6 +69,10 @@ void printSummary(std::ostream& os, const RunReport& r);
 /// Writes the JSON report. Returns false with a reason.
 bool writeJsonReport(const RunReport& r, const std::string& path, std::string& error);
 
+/// JSON literals: a quoted, escaped string; a number ("null" when not finite).
+std::string jsonString(const std::string& s);
+std::string jsonNumber(double v);
+
 /// The report as a JSON object (also used by the tests through the file).
 std::string toJson(const RunReport& r);
 

@@ -3,10 +3,12 @@
 //   sdfcage [INPUT] [-o OUT] [-n N] [--iso C] [--voxel H] [--clearance D] [--adaptivity A]
 //           [--refinements N] [--report FILE.json] [--screenshot FILE.png] [--threads N] [--quiet]
 //           [--help] [--version]
+//   sdfcage --check INPUT CAGE [--report FILE.json] [--quiet]
 //
 // Exit codes: 0 cage written and enclosure verified; 1 enclosure could not be verified;
 // 2 bad command line or unusable input; 3 could not write an output, render, or other failure;
 // 130 interrupted (Ctrl-C).
+#include "CLICheck.h"
 #include "CLIMeshIO.h"
 #include "CLIMessages.h"
 #include "CLIReport.h"
@@ -59,6 +61,7 @@ const char* const Program = "sdfcage";
 void printUsage(std::ostream& os)
 {
   os << "Usage: sdfcage [INPUT] [options]\n"
+        "       sdfcage --check INPUT CAGE [--report FILE.json] [--quiet]\n"
         "\n"
         "Builds a cage (a coarse closed mesh that strictly encloses the input) from an SDF\n"
         "envelope, simplified to N vertices, and verifies it. INPUT is a closed mesh file\n"
@@ -91,6 +94,11 @@ void printUsage(std::ostream& os)
         "  -h, --help              this help\n"
         "      --version           program and library versions\n"
         "\n"
+        "--check INPUT CAGE judges any cage (from any program) against its input: distances\n"
+        "(clearance, Hausdorff both ways, mean), self-intersections, intersections with the\n"
+        "input, input vertices outside, genus, and the exact verdict: does CAGE strictly\n"
+        "enclose INPUT? Exit codes: 0 it encloses, 1 it does not, 2 a file cannot be used.\n"
+        "\n"
         "Exit codes: 0 cage written and enclosure verified; 1 enclosure not verified;\n"
         "2 bad command line or unusable input (missing file, unknown format, open or\n"
         "non-manifold mesh, ...); 3 an output could not be written or rendered; 130 interrupted.\n";
@@ -112,6 +120,8 @@ struct Options
   bool Quiet = false;
   bool Help = false;
   bool Version = false;
+  bool Check = false;      ///< --check INPUT CAGE
+  std::string Cage;        ///< the cage of --check
 };
 
 /// Thrown for a bad command line; main() prints the message and the usage, exit code 2.
@@ -149,21 +159,18 @@ Options parseOptions(int argc, char* argv[], vtkSDFCageFilter* limits)
 {
   Options o;
   bool positionalOnly = false;
+  std::vector<std::string> positionals;
+  std::vector<std::string> buildOptions; // options that only make sense when building a cage
   for (int i = 1; i < argc; ++i)
   {
     std::string arg = argv[i];
     if (positionalOnly || arg.empty() || arg[0] != '-' || arg == "-")
     {
-      if (!o.Input.empty())
-      {
-        throw UsageError{ "more than one input given ('" + o.Input + "' and '" + arg +
-          "'): sdfcage reads one mesh" };
-      }
       if (arg.empty())
       {
         throw UsageError{ "empty input file name" };
       }
-      o.Input = arg;
+      positionals.push_back(arg);
       continue;
     }
     if (arg == "--")
@@ -202,7 +209,17 @@ Options parseOptions(int argc, char* argv[], vtkSDFCageFilter* limits)
       }
     };
 
-    if (arg == "-h" || arg == "--help")
+    if (arg != "--report" && arg != "-q" && arg != "--quiet" && arg != "--check" && arg != "-h" &&
+      arg != "--help" && arg != "--version")
+    {
+      buildOptions.push_back(arg);
+    }
+    if (arg == "--check")
+    {
+      noValue();
+      o.Check = true;
+    }
+    else if (arg == "-h" || arg == "--help")
     {
       noValue();
       o.Help = true;
@@ -281,6 +298,39 @@ Options parseOptions(int argc, char* argv[], vtkSDFCageFilter* limits)
     {
       throw UsageError{ "unknown option '" + arg + "'" };
     }
+  }
+  if (o.Check && !o.Help && !o.Version)
+  {
+    if (positionals.size() != 2)
+    {
+      throw UsageError{ "--check needs two files, INPUT and CAGE (got " +
+        std::to_string(positionals.size()) + ")" };
+    }
+    if (!buildOptions.empty())
+    {
+      throw UsageError{ "--check takes only --report and --quiet; '" + buildOptions.front() +
+        "' is an option for building a cage" };
+    }
+    o.Input = positionals[0];
+    o.Cage = positionals[1];
+    for (const std::string& file : positionals)
+    {
+      if (!isSupportedExtension(file))
+      {
+        throw UsageError{ "cannot read '" + file + "': unknown extension '" + lowerExtension(file) +
+          "' (supported: " + supportedExtensions() + ")" };
+      }
+    }
+    return o;
+  }
+  if (positionals.size() > 1)
+  {
+    throw UsageError{ "more than one input given ('" + positionals[0] + "' and '" + positionals[1] +
+      "'): sdfcage reads one mesh (to judge a cage: sdfcage --check INPUT CAGE)" };
+  }
+  if (!positionals.empty())
+  {
+    o.Input = positionals[0];
   }
   if (!o.Input.empty() && !isSupportedExtension(o.Input))
   {
@@ -686,6 +736,10 @@ int main(int argc, char* argv[])
                 << (renderingAvailable() ? ", with rendering" : ", without rendering")
                 << ")\n";
       return ExitOk;
+    }
+    if (options.Check)
+    {
+      return runCheck(options.Input, options.Cage, options.Report, options.Quiet, messages);
     }
     return run(options, messages);
   }

@@ -194,13 +194,24 @@ if (DEFINED REPORT)
     if (jsonError OR NOT type STREQUAL "OBJECT")
       list(APPEND failures "report is not a JSON object: ${jsonError}")
     else ()
-      # every result the filter has must be there, under its getter's name
-      foreach (key IN ITEMS InputFile OutputFile InputPoints InputTriangles EnvelopePoints
+      # every result the filter has must be there, under its getter's name (for --check:
+      # vtkCageQualityFilter's)
+      set(required_keys InputFile OutputFile InputPoints InputTriangles EnvelopePoints
           EnvelopeTriangles CagePoints CageTriangles ValidationTime DistanceFieldTime
           IsosurfaceTime VerificationTime SimplificationTime CageVerificationTime TotalTime
           MeasuredClearance MeasuredClearanceRelative EnclosureVerified RemovedPockets
           EnvelopeGenus EnvelopeComponents VoxelSizeUsed InputWasFlipped VerticesReached
           TargetReached StopReason TargetNumberOfVertices Status ExitCode)
+      string(JSON mode ERROR_VARIABLE modeError GET "${json}" "Mode")
+      if (NOT modeError AND mode STREQUAL "check")
+        set(required_keys InputFile CageFile InputPoints InputTriangles CagePoints CageTriangles
+            Encloses MinimumClearance MinimumClearanceRelative HausdorffCageToInput
+            HausdorffCageToInputRelative HausdorffInputToCage HausdorffInputToCageRelative
+            MeanDistanceCageToInput MeanDistanceCageToInputRelative SelfIntersections
+            InputIntersections InputVerticesOutside CageGenus InputGenus QualityMessage
+            QualityTime Status ErrorMessage ExitCode)
+      endif ()
+      foreach (key IN LISTS required_keys)
         string(JSON value ERROR_VARIABLE keyError GET "${json}" "${key}")
         if (keyError)
           list(APPEND failures "report has no key ${key}")

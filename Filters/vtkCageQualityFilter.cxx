@@ -1,0 +1,359 @@
+/*=========================================================================
+
+  Program:   SDFCage
+  Module:    vtkCageQualityFilter.cxx
+
+=========================================================================*/
+#include "vtkCageQualityFilter.h"
+
+#include "vtkAlgorithmOutput.h"
+#include "vtkCellArray.h"
+#include "vtkCellArrayIterator.h"
+#include "vtkCellData.h"
+#include "vtkDoubleArray.h"
+#include "vtkExecutive.h"
+#include "vtkFieldData.h"
+#include "vtkIdTypeArray.h"
+#include "vtkInformation.h"
+#include "vtkInformationVector.h"
+#include "vtkIntArray.h"
+#include "vtkNew.h"
+#include "vtkObjectFactory.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkSmartPointer.h"
+#include "vtkStringArray.h"
+
+#include "CageQuality.h"
+#include "Progress.h"
+
+#include <cmath>
+#include <exception>
+#include <limits>
+#include <new>
+#include <string>
+#include <thread>
+#include <vector>
+
+vtkStandardNewMacro(vtkCageQualityFilter);
+
+namespace
+{
+//------------------------------------------------------------------------------
+// Forwards Core's progress to the filter and the filter's abort flag to Core; VTK objects are
+// only touched from the thread that runs RequestData.
+class QualityProgress final : public sdfcage::Progress
+{
+public:
+  explicit QualityProgress(vtkCageQualityFilter* filter)
+    : Filter(filter)
+    , Owner(std::this_thread::get_id())
+  {
+  }
+
+protected:
+  void report(double overall, const std::string& stage) override
+  {
+    if (std::this_thread::get_id() != this->Owner || stage == this->LastStage)
+    {
+      return; // phase boundaries only: a few updates per run
+    }
+    this->LastStage = stage;
+    this->Filter->SetProgressText(stage.c_str());
+    this->Filter->UpdateProgress(overall);
+  }
+  bool pollCancel() override
+  {
+    return std::this_thread::get_id() == this->Owner && this->Filter->GetAbortExecute() != 0;
+  }
+
+private:
+  vtkCageQualityFilter* Filter;
+  std::thread::id Owner;
+  std::string LastStage;
+};
+
+//------------------------------------------------------------------------------
+// Fan-triangulates the polygons and strips of `data`; `cellOfTriangle[i]` is the id (in the
+// polydata's cell numbering: verts, lines, polys, strips) of the cell triangle i came from.
+// Ids are copied unchecked: Core reports out-of-range ids as invalid triangles.
+void ToTriangles(vtkPolyData* data, sdfcage::TriangleMesh& mesh, std::vector<vtkIdType>& cellOfTriangle)
+{
+  const vtkIdType np = data->GetNumberOfPoints();
+  mesh.Points.resize(static_cast<std::size_t>(np));
+  double p[3];
+  for (vtkIdType i = 0; i < np; ++i)
+  {
+    data->GetPoint(i, p);
+    mesh.Points[static_cast<std::size_t>(i)] = sdfcage::Vec3(p[0], p[1], p[2]);
+  }
+  auto toInt = [](vtkIdType id) {
+    return id < 0 || id > std::numeric_limits<int>::max() ? -1 : static_cast<int>(id);
+  };
+  vtkIdType cellId = data->GetNumberOfVerts() + data->GetNumberOfLines();
+  vtkIdType npts = 0;
+  const vtkIdType* pts = nullptr;
+  if (vtkCellArray* polys = data->GetPolys())
+  {
+    auto it = vtk::TakeSmartPointer(polys->NewIterator());
+    for (it->GoToFirstCell(); !it->IsDoneWithTraversal(); it->GoToNextCell(), ++cellId)
+    {
+      it->GetCurrentCell(npts, pts);
+      for (vtkIdType k = 1; k + 1 < npts; ++k)
+      {
+        mesh.Triangles.push_back({ toInt(pts[0]), toInt(pts[k]), toInt(pts[k + 1]) });
+        cellOfTriangle.push_back(cellId);
+      }
+    }
+  }
+  if (vtkCellArray* strips = data->GetStrips())
+  {
+    auto it = vtk::TakeSmartPointer(strips->NewIterator());
+    for (it->GoToFirstCell(); !it->IsDoneWithTraversal(); it->GoToNextCell(), ++cellId)
+    {
+      it->GetCurrentCell(npts, pts);
+      for (vtkIdType k = 0; k + 2 < npts; ++k)
+      {
+        vtkIdType a = pts[k], b = pts[k + 1];
+        const vtkIdType c = pts[k + 2];
+        if (a == b || b == c || a == c)
+        {
+          continue; // the turn of a strip, not a surface triangle
+        }
+        if (k % 2 == 1)
+        {
+          std::swap(a, b);
+        }
+        mesh.Triangles.push_back({ toInt(a), toInt(b), toInt(c) });
+        cellOfTriangle.push_back(cellId);
+      }
+    }
+  }
+}
+
+template <class ArrayT, class ValueT>
+void AddFieldValue(vtkFieldData* fd, const char* name, const ValueT& value)
+{
+  vtkNew<ArrayT> array;
+  array->SetName(name);
+  array->SetNumberOfTuples(1);
+  array->SetValue(0, value);
+  fd->AddArray(array);
+}
+
+vtkSmartPointer<vtkDoubleArray> NewArray(const char* name, vtkIdType n)
+{
+  auto array = vtkSmartPointer<vtkDoubleArray>::New();
+  array->SetName(name);
+  array->SetNumberOfTuples(n);
+  array->Fill(std::numeric_limits<double>::quiet_NaN());
+  return array;
+}
+} // namespace
+
+//------------------------------------------------------------------------------
+vtkCageQualityFilter::vtkCageQualityFilter()
+{
+  this->HausdorffTolerance = sdfcage::CageQualityOptions().HausdorffTolerance;
+  this->SetNumberOfInputPorts(2);
+  this->SetNumberOfOutputPorts(1);
+}
+
+//------------------------------------------------------------------------------
+vtkCageQualityFilter::~vtkCageQualityFilter() = default;
+
+//------------------------------------------------------------------------------
+void vtkCageQualityFilter::SetSourceConnection(vtkAlgorithmOutput* algOutput)
+{
+  this->SetInputConnection(1, algOutput);
+}
+
+void vtkCageQualityFilter::SetSourceData(vtkPolyData* source)
+{
+  this->SetInputData(1, source);
+}
+
+vtkPolyData* vtkCageQualityFilter::GetSource()
+{
+  if (this->GetNumberOfInputConnections(1) < 1)
+  {
+    return nullptr;
+  }
+  return vtkPolyData::SafeDownCast(this->GetExecutive()->GetInputData(1, 0));
+}
+
+//------------------------------------------------------------------------------
+int vtkCageQualityFilter::FillInputPortInformation(int port, vtkInformation* info)
+{
+  info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPolyData");
+  (void)port;
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+void vtkCageQualityFilter::ResetResults()
+{
+  this->Encloses = false;
+  this->MinimumClearance = this->MinimumClearanceRelative = 0.0;
+  this->HausdorffCageToInput = this->HausdorffCageToInputRelative = this->HausdorffCageToInputBound = 0.0;
+  this->HausdorffInputToCage = this->HausdorffInputToCageRelative = this->HausdorffInputToCageBound = 0.0;
+  this->MeanDistanceCageToInput = this->MeanDistanceCageToInputRelative = 0.0;
+  this->SelfIntersections = this->InputIntersections = this->InputVerticesOutside = 0;
+  this->CageGenus = this->InputGenus = -1;
+  this->QualityTime = 0.0;
+  this->QualityMessage.clear();
+}
+
+//------------------------------------------------------------------------------
+int vtkCageQualityFilter::RequestData(vtkInformation* vtkNotUsed(request),
+  vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  this->ResetResults();
+  vtkPolyData* cage = vtkPolyData::GetData(inputVector[0], 0);
+  vtkPolyData* mesh = vtkPolyData::GetData(inputVector[1], 0);
+  vtkPolyData* output = vtkPolyData::GetData(outputVector, 0);
+  if (!output)
+  {
+    vtkErrorMacro("The output data object is missing or of the wrong type.");
+    return 0;
+  }
+  output->Initialize();
+  if (!cage || cage->GetNumberOfCells() == 0)
+  {
+    return 1; // empty cage: empty output, not an error
+  }
+  if (!mesh)
+  {
+    vtkErrorMacro("No input mesh: connect the mesh the cage should enclose with SetSourceConnection "
+                  "(input port 1).");
+    return 0;
+  }
+  output->ShallowCopy(cage);
+
+  auto publish = [&]() {
+    vtkFieldData* fd = output->GetFieldData();
+    AddFieldValue<vtkIntArray>(fd, "Encloses", this->Encloses ? 1 : 0);
+    AddFieldValue<vtkDoubleArray>(fd, "MinimumClearance", this->MinimumClearance);
+    AddFieldValue<vtkDoubleArray>(fd, "MinimumClearanceRelative", this->MinimumClearanceRelative);
+    AddFieldValue<vtkDoubleArray>(fd, "HausdorffCageToInput", this->HausdorffCageToInput);
+    AddFieldValue<vtkDoubleArray>(fd, "HausdorffCageToInputRelative", this->HausdorffCageToInputRelative);
+    AddFieldValue<vtkDoubleArray>(fd, "HausdorffCageToInputBound", this->HausdorffCageToInputBound);
+    AddFieldValue<vtkDoubleArray>(fd, "HausdorffInputToCage", this->HausdorffInputToCage);
+    AddFieldValue<vtkDoubleArray>(fd, "HausdorffInputToCageRelative", this->HausdorffInputToCageRelative);
+    AddFieldValue<vtkDoubleArray>(fd, "HausdorffInputToCageBound", this->HausdorffInputToCageBound);
+    AddFieldValue<vtkDoubleArray>(fd, "MeanDistanceCageToInput", this->MeanDistanceCageToInput);
+    AddFieldValue<vtkDoubleArray>(fd, "MeanDistanceCageToInputRelative", this->MeanDistanceCageToInputRelative);
+    AddFieldValue<vtkIdTypeArray>(fd, "SelfIntersections", this->SelfIntersections);
+    AddFieldValue<vtkIdTypeArray>(fd, "InputIntersections", this->InputIntersections);
+    AddFieldValue<vtkIdTypeArray>(fd, "InputVerticesOutside", this->InputVerticesOutside);
+    AddFieldValue<vtkIntArray>(fd, "CageGenus", this->CageGenus);
+    AddFieldValue<vtkIntArray>(fd, "InputGenus", this->InputGenus);
+    AddFieldValue<vtkDoubleArray>(fd, "QualityTime", this->QualityTime);
+    AddFieldValue<vtkStringArray>(fd, "QualityMessage", this->QualityMessage);
+  };
+
+  try
+  {
+    sdfcage::TriangleMesh cageMesh, inputMesh;
+    std::vector<vtkIdType> cellOfTriangle, unused;
+    ToTriangles(cage, cageMesh, cellOfTriangle);
+    ToTriangles(mesh, inputMesh, unused);
+
+    sdfcage::CageQualityOptions options;
+    options.HausdorffTolerance = this->HausdorffTolerance;
+    QualityProgress progress(this);
+    this->UpdateProgress(0.0);
+    const sdfcage::CageQualityResult q = sdfcage::evaluateCage(inputMesh, cageMesh, options, &progress);
+    if (q.Message == "cancelled")
+    {
+      output->Initialize();
+      return 1;
+    }
+
+    // point and cell arrays
+    const vtkIdType np = cage->GetNumberOfPoints(), nc = cage->GetNumberOfCells();
+    auto pointDistance = NewArray("DistanceToInput", np);
+    for (vtkIdType i = 0; i < np; ++i)
+    {
+      pointDistance->SetValue(i, q.PointDistance[static_cast<std::size_t>(i)]);
+    }
+    output->GetPointData()->AddArray(pointDistance);
+    auto cellDistance = NewArray("DistanceToInput", nc);
+    auto minimumAngle = NewArray("MinimumAngle", nc);
+    auto mips = NewArray("MIPSEnergy", nc);
+    for (std::size_t t = 0; t < cellOfTriangle.size(); ++t)
+    {
+      const vtkIdType c = cellOfTriangle[t];
+      auto merge = [c](vtkDoubleArray* a, double v, bool takeMax) {
+        const double old = a->GetValue(c);
+        if (std::isnan(old) || (!std::isnan(v) && (takeMax ? v > old : v < old)))
+        {
+          a->SetValue(c, v);
+        }
+      };
+      merge(cellDistance, q.CellDistance[t], true);
+      merge(minimumAngle, q.CellMinimumAngle[t], false);
+      merge(mips, q.CellMIPSEnergy[t], true);
+    }
+    output->GetCellData()->AddArray(cellDistance);
+    output->GetCellData()->AddArray(minimumAngle);
+    output->GetCellData()->AddArray(mips);
+    output->GetPointData()->SetActiveScalars("DistanceToInput");
+
+    const double diagonal = q.Diagonal > 0 ? q.Diagonal : 1.0;
+    this->Encloses = q.Encloses;
+    this->MinimumClearance = q.MinimumClearance;
+    this->MinimumClearanceRelative = q.MinimumClearance / diagonal;
+    this->HausdorffCageToInput = q.HausdorffCageToInput;
+    this->HausdorffCageToInputRelative = q.HausdorffCageToInput / diagonal;
+    this->HausdorffCageToInputBound = q.HausdorffCageToInputBound;
+    this->HausdorffInputToCage = q.HausdorffInputToCage;
+    this->HausdorffInputToCageRelative = q.HausdorffInputToCage / diagonal;
+    this->HausdorffInputToCageBound = q.HausdorffInputToCageBound;
+    this->MeanDistanceCageToInput = q.MeanDistanceCageToInput;
+    this->MeanDistanceCageToInputRelative = q.MeanDistanceCageToInput / diagonal;
+    this->SelfIntersections = static_cast<vtkIdType>(q.SelfIntersections);
+    this->InputIntersections = static_cast<vtkIdType>(q.InputIntersections);
+    this->InputVerticesOutside = static_cast<vtkIdType>(q.InputVerticesOutside);
+    this->CageGenus = q.CageGenus;
+    this->InputGenus = q.InputGenus;
+    this->QualityTime = q.Seconds;
+    this->QualityMessage = q.Message;
+    publish();
+    this->UpdateProgress(1.0);
+    return 1;
+  }
+  catch (const std::bad_alloc&)
+  {
+    vtkErrorMacro("Out of memory while evaluating the cage.");
+  }
+  catch (const std::exception& e)
+  {
+    vtkErrorMacro("Internal error while evaluating the cage: " << e.what());
+  }
+  catch (...)
+  {
+    vtkErrorMacro("Unknown internal error while evaluating the cage.");
+  }
+  output->Initialize();
+  return 0;
+}
+
+//------------------------------------------------------------------------------
+void vtkCageQualityFilter::PrintSelf(ostream& os, vtkIndent indent)
+{
+  this->Superclass::PrintSelf(os, indent);
+  os << indent << "HausdorffTolerance: " << this->HausdorffTolerance << "\n";
+  os << indent << "Encloses: " << this->Encloses << "\n";
+  os << indent << "MinimumClearance: " << this->MinimumClearance << "\n";
+  os << indent << "HausdorffCageToInput: " << this->HausdorffCageToInput << "\n";
+  os << indent << "HausdorffInputToCage: " << this->HausdorffInputToCage << "\n";
+  os << indent << "MeanDistanceCageToInput: " << this->MeanDistanceCageToInput << "\n";
+  os << indent << "SelfIntersections: " << this->SelfIntersections << "\n";
+  os << indent << "InputIntersections: " << this->InputIntersections << "\n";
+  os << indent << "InputVerticesOutside: " << this->InputVerticesOutside << "\n";
+  os << indent << "CageGenus: " << this->CageGenus << "\n";
+  os << indent << "InputGenus: " << this->InputGenus << "\n";
+  os << indent << "QualityMessage: " << this->QualityMessage << "\n";
+}

@@ -1,0 +1,147 @@
+/*=========================================================================
+
+  Program:   SDFCage
+  Module:    vtkCageQualityFilter.h
+
+  SDFCage: cages from an SDF envelope, as VTK filters and a ParaView plugin.
+
+=========================================================================*/
+/**
+ * @class   vtkCageQualityFilter
+ * @brief   judge a cage against the mesh it should enclose: distances, shape, enclosure verdict
+ *
+ * Input 0 is a cage (any surface mesh: made by vtkSDFCageFilter or by another program, and
+ * possibly broken), input 1 (SetSourceConnection / SetSourceData) is the mesh it should
+ * enclose. The output is the cage with
+ * - point array `DistanceToInput`: exact distance of each cage point to the input;
+ * - cell arrays `DistanceToInput` (the largest distance to the input found on the cell: its
+ *   corners, at least 16 quadrature points and the Hausdorff search samples), `MinimumAngle`
+ *   (degrees) and `MIPSEnergy` (the MIPS energy of "High-quality Cage Generation Based on SDF",
+ *   eq. 8, against an equilateral reference: 2 for an equilateral triangle, +inf degenerate);
+ * - field data (one-tuple arrays, named like the getters): `Encloses` (0/1), `MinimumClearance`,
+ *   `HausdorffCageToInput`, `HausdorffInputToCage`, `MeanDistanceCageToInput` (each also as
+ *   `...Relative`, divided by the input's bounding-box diagonal), the certified upper bounds
+ *   `HausdorffCageToInputBound`, `HausdorffInputToCageBound`, the counts `SelfIntersections`,
+ *   `InputIntersections`, `InputVerticesOutside`, `CageGenus`, `InputGenus` (-1 when not a
+ *   closed 2-manifold), `QualityTime` (seconds) and the string array `QualityMessage` (why the
+ *   cage does not enclose, empty when it does).
+ *
+ * Encloses is exact in effect, never sampled: the cage is a closed, consistently oriented
+ * 2-manifold without degenerate triangles, no two non-adjacent cage triangles intersect or touch,
+ * no cage triangle intersects or touches an input triangle, and every input vertex is strictly
+ * inside (odd winding number). Touching means a computed triangle–triangle distance below 1e-10 of
+ * the larger bounding-box diagonal (what the double-precision predicates of Core cannot tell
+ * from contact), so a cage that keeps 1e-6 of the diagonal is judged enclosing and one that
+ * touches is not. The
+ * Hausdorff distances are found by branch and bound over the surfaces (the distance is
+ * 1-Lipschitz) to within 1e-4 of the diagonal; the mean distance is a midpoint-rule quadrature
+ * (at least 16 points per cage triangle, sub-triangles of at most 2% of the diagonal).
+ *
+ * The work is done by SDFCage::Core (sdfcage::evaluateCage) with TBB threads; results do not
+ * depend on the number of threads. GetAbortExecute() stops at the next phase with an empty
+ * output.
+ *
+ * @warning Polygons and triangle strips of either mesh are fan-triangulated; a cell's values are
+ * then aggregated over its triangles (max distance, min angle, max MIPS energy). Vertex and line
+ * cells are ignored (their cell values are NaN). A broken cage (open, non-manifold,
+ * self-intersecting, invalid ids) is not an error: it is judged, Encloses is 0 and
+ * QualityMessage says why. An empty cage gives an empty output; an empty input mesh gives the
+ * cage with Encloses 0.
+ *
+ * @sa
+ * vtkSDFCageFilter vtkDistancePolyDataFilter vtkMeshQuality
+ */
+
+#ifndef vtkCageQualityFilter_h
+#define vtkCageQualityFilter_h
+
+#include "SDFCageFiltersModule.h" // For export macro
+#include "vtkPolyDataAlgorithm.h"
+
+#include <string> // For the message
+
+class SDFCAGEFILTERS_EXPORT vtkCageQualityFilter : public vtkPolyDataAlgorithm
+{
+public:
+  vtkTypeMacro(vtkCageQualityFilter, vtkPolyDataAlgorithm);
+  void PrintSelf(ostream& os, vtkIndent indent) override;
+  static vtkCageQualityFilter* New();
+
+  ///@{
+  /**
+   * The mesh the cage should enclose (input port 1).
+   */
+  void SetSourceConnection(vtkAlgorithmOutput* algOutput);
+  void SetSourceData(vtkPolyData* source);
+  vtkPolyData* GetSource();
+  ///@}
+
+  ///@{
+  /**
+   * Accuracy of the Hausdorff distances, relative to the input's bounding-box diagonal
+   * (default 1e-4): the reported value and its certified bound differ by at most this much
+   * unless the evaluation budget runs out.
+   */
+  vtkSetClampMacro(HausdorffTolerance, double, 1e-8, 0.1);
+  vtkGetMacro(HausdorffTolerance, double);
+  ///@}
+
+  ///@{
+  /**
+   * Results, valid after the filter has executed (also in the output's field data).
+   */
+  vtkGetMacro(Encloses, bool);
+  vtkGetMacro(MinimumClearance, double);
+  vtkGetMacro(MinimumClearanceRelative, double);
+  vtkGetMacro(HausdorffCageToInput, double);
+  vtkGetMacro(HausdorffCageToInputRelative, double);
+  vtkGetMacro(HausdorffCageToInputBound, double);
+  vtkGetMacro(HausdorffInputToCage, double);
+  vtkGetMacro(HausdorffInputToCageRelative, double);
+  vtkGetMacro(HausdorffInputToCageBound, double);
+  vtkGetMacro(MeanDistanceCageToInput, double);
+  vtkGetMacro(MeanDistanceCageToInputRelative, double);
+  vtkGetMacro(SelfIntersections, vtkIdType);
+  vtkGetMacro(InputIntersections, vtkIdType);
+  vtkGetMacro(InputVerticesOutside, vtkIdType);
+  vtkGetMacro(CageGenus, int);
+  vtkGetMacro(InputGenus, int);
+  vtkGetMacro(QualityTime, double);
+  const char* GetQualityMessage() const { return this->QualityMessage.c_str(); }
+  ///@}
+
+protected:
+  vtkCageQualityFilter();
+  ~vtkCageQualityFilter() override;
+
+  int FillInputPortInformation(int port, vtkInformation* info) override;
+  int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+
+  double HausdorffTolerance;
+
+  bool Encloses = false;
+  double MinimumClearance = 0.0;
+  double MinimumClearanceRelative = 0.0;
+  double HausdorffCageToInput = 0.0;
+  double HausdorffCageToInputRelative = 0.0;
+  double HausdorffCageToInputBound = 0.0;
+  double HausdorffInputToCage = 0.0;
+  double HausdorffInputToCageRelative = 0.0;
+  double HausdorffInputToCageBound = 0.0;
+  double MeanDistanceCageToInput = 0.0;
+  double MeanDistanceCageToInputRelative = 0.0;
+  vtkIdType SelfIntersections = 0;
+  vtkIdType InputIntersections = 0;
+  vtkIdType InputVerticesOutside = 0;
+  int CageGenus = -1;
+  int InputGenus = -1;
+  double QualityTime = 0.0;
+  std::string QualityMessage;
+
+private:
+  void ResetResults();
+  vtkCageQualityFilter(const vtkCageQualityFilter&) = delete;
+  void operator=(const vtkCageQualityFilter&) = delete;
+};
+
+#endif

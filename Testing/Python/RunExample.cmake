@@ -1,0 +1,36 @@
+# Runs an example script and checks what it promises: exit code 0, "encloses       : yes" on
+# stdout, and a real PNG picture (Testing/CLI/check_png.py).
+#   cmake -DCOMMAND="prog|script|args" -DWORKDIR=<folder> -DPNG=<file> -DPYTHON=<python>
+#         -DPNG_CHECK=<check_png.py> -P RunExample.cmake
+foreach (var IN ITEMS COMMAND WORKDIR PNG PYTHON PNG_CHECK)
+  if (NOT DEFINED ${var})
+    message(FATAL_ERROR "RunExample.cmake: ${var} is not set")
+  endif ()
+endforeach ()
+file(REMOVE_RECURSE "${WORKDIR}")
+file(MAKE_DIRECTORY "${WORKDIR}")
+string(REPLACE "|" ";" command "${COMMAND}")
+execute_process(COMMAND ${command} WORKING_DIRECTORY "${WORKDIR}"
+  RESULT_VARIABLE code OUTPUT_VARIABLE out ERROR_VARIABLE err)
+message("exit code ${code}\n--- stdout ---\n${out}--- stderr ---\n${err}--------------")
+set(failures)
+if (NOT code EQUAL 0)
+  list(APPEND failures "exit code ${code}, expected 0")
+endif ()
+if (NOT out MATCHES "encloses       : yes")
+  list(APPEND failures "stdout does not say the cage encloses the input")
+endif ()
+if (NOT out MATCHES "screenshot     : ")
+  list(APPEND failures "stdout does not name the screenshot")
+endif ()
+execute_process(COMMAND "${PYTHON}" "${PNG_CHECK}" "${WORKDIR}/${PNG}"
+  RESULT_VARIABLE pngCode OUTPUT_VARIABLE pngOut ERROR_VARIABLE pngErr)
+message("${pngOut}${pngErr}")
+if (NOT pngCode EQUAL 0)
+  list(APPEND failures "the screenshot is not a real picture")
+endif ()
+if (failures)
+  string(REPLACE ";" "\n  " failures "${failures}")
+  message(FATAL_ERROR "FAILED:\n  ${failures}")
+endif ()
+message("passed")
