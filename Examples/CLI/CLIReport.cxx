@@ -102,6 +102,11 @@ std::string toJson(const RunReport& r)
   key("Adaptivity") << jsonNumber(r.Adaptivity);
   key("MaximumRefinements") << r.MaximumRefinements;
   key("NumberOfThreads") << r.NumberOfThreads;
+  key("UseActivePoints") << (r.UseActivePoints ? "true" : "false");
+  key("ActiveRadius") << jsonNumber(r.ActiveRadius);
+  key("GeodesicThreshold") << jsonNumber(r.GeodesicThreshold);
+  key("AmplificationAlpha") << jsonNumber(r.AmplificationAlpha);
+  key("AmplificationBeta") << jsonNumber(r.AmplificationBeta);
   key("InputPoints") << r.InputPoints;
   key("InputCells") << r.InputCells;
   key("InputTriangles") << r.InputTriangles;
@@ -129,6 +134,9 @@ std::string toJson(const RunReport& r)
   key("StopReason") << jsonString(r.StopReason);
   key("VoxelSizeUsed") << jsonNumber(r.VoxelSizeUsed);
   key("InputWasFlipped") << (r.InputWasFlipped ? "true" : "false");
+  key("NumberOfActivePoints") << r.NumberOfActivePoints;
+  key("ActivePointTime") << jsonNumber(r.ActivePointTime);
+  key("TopologyWarning") << jsonString(r.TopologyWarning);
   os << "\n}\n";
   return os.str();
 }
@@ -168,6 +176,16 @@ void printSummary(std::ostream& os, const RunReport& r)
   {
     return;
   }
+  if (r.UseActivePoints)
+  {
+    os << "active pts  : " << r.NumberOfActivePoints << " input points (r " << number(r.ActiveRadius)
+       << ", l " << number(r.GeodesicThreshold) << ", alpha " << number(r.AmplificationAlpha)
+       << ", beta " << number(r.AmplificationBeta) << "), " << seconds(r.ActivePointTime) << "\n";
+  }
+  else
+  {
+    os << "active pts  : off (plain offset)\n";
+  }
   os << "envelope    : " << r.EnvelopePoints << " points, " << r.EnvelopeTriangles
      << " triangles, " << r.EnvelopeComponents << " component(s), genus " << r.EnvelopeGenus
      << ", " << r.RemovedPockets << " trapped pocket(s) removed\n";
@@ -193,7 +211,7 @@ void printSummary(std::ostream& os, const RunReport& r)
      << "unit sphere), isovalue " << number(r.IsoValue) << ", adaptivity "
      << number(r.Adaptivity) << "\n";
   os << "timings     : validation " << seconds(r.ValidationTime) << ", distance field "
-     << seconds(r.DistanceFieldTime) << ", isosurface " << seconds(r.IsosurfaceTime)
+     << seconds(r.DistanceFieldTime) << ", active points " << seconds(r.ActivePointTime) << ", isosurface " << seconds(r.IsosurfaceTime)
      << ", verification " << seconds(r.VerificationTime) << ",\n              simplification "
      << seconds(r.SimplificationTime) << ", cage verification "
      << seconds(r.CageVerificationTime) << ", total " << seconds(r.TotalTime) << "\n";

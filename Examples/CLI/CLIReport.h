@@ -24,6 +24,11 @@ struct RunReport
   int TargetNumberOfVertices = 0; ///< the target (0 = no simplification)
   int MaximumRefinements = 0;
   int NumberOfThreads = 0;
+  bool UseActivePoints = true;
+  double ActiveRadius = 0.0;
+  double GeodesicThreshold = 0.0;
+  double AmplificationAlpha = 0.0;
+  double AmplificationBeta = 0.0;
 
   // counts
   long long InputPoints = 0;
@@ -55,6 +60,9 @@ struct RunReport
   std::string StopReason; ///< why the simplification stopped early ("" when it reached N)
   double VoxelSizeUsed = 0.0;
   bool InputWasFlipped = false;
+  long long NumberOfActivePoints = 0; ///< input points found active
+  double ActivePointTime = 0.0;
+  std::string TopologyWarning; ///< set when the envelope's genus/components differ from the input's
   bool FilterRan = false; ///< false when the run stopped before the filter (e.g. unreadable)
 
   // outcome

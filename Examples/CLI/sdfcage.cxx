@@ -1,8 +1,9 @@
 // SDFCage — the command-line program: a closed mesh (or the built-in shape) -> its cage.
 //
 //   sdfcage [INPUT] [-o OUT] [-n N] [--iso C] [--voxel H] [--clearance D] [--adaptivity A]
-//           [--refinements N] [--report FILE.json] [--screenshot FILE.png] [--threads N] [--quiet]
-//           [--help] [--version]
+//           [--refinements N] [--no-active-points] [--active-radius R] [--geodesic-threshold L]
+//           [--alpha A] [--beta B] [--report FILE.json] [--screenshot FILE.png] [--threads N]
+//           [--quiet] [--help] [--version]
 //   sdfcage --check INPUT CAGE [--report FILE.json] [--quiet]
 //
 // Exit codes: 0 cage written and enclosure verified; 1 enclosure could not be verified;
@@ -85,6 +86,14 @@ void printUsage(std::ostream& os)
         "      --adaptivity A      isosurface adaptivity in [0, 1]: 0 uniform triangles, larger\n"
         "                          merges flat regions (fewer triangles); default 0.1\n"
         "      --refinements N     times the grid may be refined if verification fails, default 2\n"
+        "      --no-active-points  plain offset envelope: no active points, no amplified SDF\n"
+        "                          (nearly touching parts may fuse)\n"
+        "      --active-radius R   active points: another surface point closer than R in space,\n"
+        "                          default 0.025 ...\n"
+        "      --geodesic-threshold L\n"
+        "                          ... but farther than L along the surface, default 0.15\n"
+        "      --alpha A           amplification of the SDF at active points (> 1), default 3\n"
+        "      --beta B            decay of the amplification, default 8\n"
         "      --report FILE.json  write the results as JSON\n"
         "      --screenshot FILE.png\n"
         "                          render input and cage offscreen to a PNG (needs an X server:\n"
@@ -116,6 +125,11 @@ struct Options
   double Adaptivity = -1.0; ///< -1 = the filter's default
   int Vertices = -1;        ///< -1 = the filter's default
   int Refinements = -1; ///< -1 = the filter's default
+  bool NoActivePoints = false;
+  double ActiveRadius = -1.0;      ///< -1 = the filter's default
+  double GeodesicThreshold = -1.0; ///< -1 = the filter's default
+  double Alpha = -1.0;             ///< -1 = the filter's default
+  double Beta = -1.0;              ///< -1 = the filter's default
   int Threads = 0;
   bool Quiet = false;
   bool Help = false;
@@ -288,6 +302,29 @@ Options parseOptions(int argc, char* argv[], vtkSDFCageFilter* limits)
     {
       o.Refinements = parseInt(arg, takeValue(), limits->GetMaximumRefinementsMinValue(),
         limits->GetMaximumRefinementsMaxValue());
+    }
+    else if (arg == "--no-active-points")
+    {
+      o.NoActivePoints = true;
+    }
+    else if (arg == "--active-radius")
+    {
+      o.ActiveRadius = parseDouble(arg, takeValue(), limits->GetActiveRadiusMinValue(), limits->GetActiveRadiusMaxValue());
+    }
+    else if (arg == "--geodesic-threshold")
+    {
+      o.GeodesicThreshold = parseDouble(
+        arg, takeValue(), limits->GetGeodesicThresholdMinValue(), limits->GetGeodesicThresholdMaxValue());
+    }
+    else if (arg == "--alpha")
+    {
+      o.Alpha = parseDouble(
+        arg, takeValue(), limits->GetAmplificationAlphaMinValue(), limits->GetAmplificationAlphaMaxValue());
+    }
+    else if (arg == "--beta")
+    {
+      o.Beta = parseDouble(
+        arg, takeValue(), limits->GetAmplificationBetaMinValue(), limits->GetAmplificationBetaMaxValue());
     }
     else if (arg == "--threads")
     {
@@ -556,6 +593,28 @@ int run(const Options& o, MessageCollector* messages)
   {
     filter->SetMaximumRefinements(o.Refinements);
   }
+  filter->SetUseActivePoints(o.NoActivePoints ? 0 : 1);
+  if (o.ActiveRadius >= 0)
+  {
+    filter->SetActiveRadius(o.ActiveRadius);
+  }
+  if (o.GeodesicThreshold >= 0)
+  {
+    filter->SetGeodesicThreshold(o.GeodesicThreshold);
+  }
+  if (o.Alpha >= 0)
+  {
+    filter->SetAmplificationAlpha(o.Alpha);
+  }
+  if (o.Beta >= 0)
+  {
+    filter->SetAmplificationBeta(o.Beta);
+  }
+  r.UseActivePoints = filter->GetUseActivePoints() != 0;
+  r.ActiveRadius = filter->GetActiveRadius();
+  r.GeodesicThreshold = filter->GetGeodesicThreshold();
+  r.AmplificationAlpha = filter->GetAmplificationAlpha();
+  r.AmplificationBeta = filter->GetAmplificationBeta();
   r.Adaptivity = filter->GetAdaptivity();
   r.TargetNumberOfVertices = filter->GetTargetNumberOfVertices();
   r.MaximumRefinements = filter->GetMaximumRefinements();
@@ -588,6 +647,9 @@ int run(const Options& o, MessageCollector* messages)
   r.EnvelopeGenus = filter->GetEnvelopeGenus();
   r.VoxelSizeUsed = filter->GetVoxelSizeUsed();
   r.InputWasFlipped = filter->GetInputWasFlipped();
+  r.NumberOfActivePoints = filter->GetNumberOfActivePoints();
+  r.ActivePointTime = filter->GetActivePointTime();
+  r.TopologyWarning = filter->GetTopologyWarning();
   r.CagePoints = cage ? cage->GetNumberOfPoints() : 0;
   r.CageTriangles = cage ? triangleCount(cage) : 0;
   r.EnvelopePoints = envelope ? envelope->GetNumberOfPoints() : 0;

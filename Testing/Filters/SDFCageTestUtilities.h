@@ -149,5 +149,7 @@ int TestDataBunnyOFF(const Context&);
 int TestOFFRoundTrip(const Context&);
 int TestOFFVariants(const Context&);
 int TestOFFMalformed(const Context&);
+int TestActivePointsBuiltin(const Context&);
+int TestActivePointsErrors(const Context&);
 
 } // namespace sdfcage_test

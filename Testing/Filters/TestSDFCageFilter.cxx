@@ -17,7 +17,9 @@
 #include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
+#include "vtkActivePointFilter.h"
 #include "vtkSDFCageFilter.h"
+#include "vtkUnsignedCharArray.h"
 #include "vtkSphereSource.h"
 #include "vtkStringArray.h"
 #include "vtkTriangleFilter.h"
@@ -719,6 +721,159 @@ int TestDataKnight(const Context& context)
 int TestDataBunnyOFF(const Context& context)
 {
   return RunOnDataFile(context, "DataBunnyOFF", "bunny.off");
+}
+
+//------------------------------------------------------------------------------
+// vtkActivePointFilter on the built-in shape (a torus 0.012 from a sphere, unit-sphere units):
+// the arrays, the counts, the optional fields; and the cage filter's UseActivePoints, which is
+// what keeps the two parts apart.
+int TestActivePointsBuiltin(const Context&)
+{
+  Checker c("ActivePointsBuiltin");
+  vtkSmartPointer<vtkPolyData> input = FromTriangleMesh(sdfcage::makeBuiltinShape());
+  vtkNew<vtkActivePointFilter> filter;
+  vtkNew<MessageRecorder> messages;
+  messages->Watch(filter);
+  messages->Watch(filter->GetExecutive());
+  filter->SetInputData(input);
+  filter->GenerateDistanceFieldsOn();
+  filter->Update();
+  c.Check(messages->Errors.empty(), "no errors");
+  c.Check(std::string(filter->GetStatusString()) == "Ok", "status Ok");
+  vtkPolyData* out = filter->GetOutput(0);
+  c.Check(out->GetNumberOfPoints() == input->GetNumberOfPoints(), "the mesh keeps its points");
+  c.Check(out->GetNumberOfCells() == input->GetNumberOfCells(), "the mesh keeps its triangles");
+  auto* active = vtkUnsignedCharArray::SafeDownCast(out->GetPointData()->GetArray("ActivePoint"));
+  auto* g = vtkDoubleArray::SafeDownCast(out->GetPointData()->GetArray("GeodesicDistanceToActive"));
+  auto* phi = vtkDoubleArray::SafeDownCast(out->GetPointData()->GetArray("Amplification"));
+  if (!c.Check(active && g && phi, "arrays ActivePoint, GeodesicDistanceToActive, Amplification"))
+  {
+    return c.Result();
+  }
+  vtkIdType count = 0;
+  for (vtkIdType i = 0; i < out->GetNumberOfPoints(); ++i)
+  {
+    const int a = active->GetValue(i);
+    c.Check(a == 0 || a == 1, "ActivePoint is 0/1");
+    count += a;
+    c.Check(phi->GetValue(i) >= 1.0 && phi->GetValue(i) <= filter->GetAmplificationAlpha() + 1e-12,
+      "1 <= Amplification <= alpha");
+    c.Check(g->GetValue(i) >= 0.0, "g_A >= 0");
+    if (a)
+    {
+      c.Check(phi->GetValue(i) > 1.5, "active points are amplified");
+    }
+  }
+  std::cout << "  active points: " << count << " of " << out->GetNumberOfPoints() << ", samples "
+            << filter->GetNumberOfActiveSamples() << " of " << filter->GetNumberOfSamples() << ", "
+            << filter->GetExecutionTime() << " s\n";
+  c.Check(count > 0, "the built-in shape has active points (its parts nearly touch)");
+  c.Check(count == filter->GetNumberOfActivePoints(), "GetNumberOfActivePoints counts them");
+  c.Check(count < out->GetNumberOfPoints() / 2, "most points are not active");
+  c.Check(FieldNumber(out, "NumberOfActivePoints") == static_cast<double>(count), "field data NumberOfActivePoints");
+  auto* fields = vtkImageData::SafeDownCast(filter->GetOutputDataObject(1));
+  c.Check(fields && fields->GetNumberOfPoints() > 1000, "output 1 holds the fields");
+  if (fields)
+  {
+    auto* xi = fields->GetPointData()->GetArray("SignedDistance");
+    auto* mod = fields->GetPointData()->GetArray("ModifiedSignedDistance");
+    c.Check(xi && mod, "SignedDistance and ModifiedSignedDistance");
+    if (xi && mod)
+    {
+      vtkIdType amplified = 0;
+      for (vtkIdType k = 0; k < xi->GetNumberOfTuples(); ++k)
+      {
+        amplified += xi->GetTuple1(k) > 0 && mod->GetTuple1(k) > 1.5 * xi->GetTuple1(k);
+      }
+      c.Check(amplified > 0, "the modified field is amplified somewhere");
+    }
+  }
+
+  // Off by default: no fields.
+  filter->GenerateDistanceFieldsOff();
+  filter->Update();
+  c.Check(IsEmpty(filter->GetOutputDataObject(1)), "no fields unless asked");
+
+  // The cage filter: with active points the envelope keeps two components, without it fuses them.
+  vtkNew<vtkSDFCageFilter> cage;
+  vtkNew<MessageRecorder> cageMessages;
+  cageMessages->Watch(cage);
+  cage->SetInputData(input);
+  cage->SetTargetNumberOfVertices(0); // the envelope is what is tested
+  c.Check(cage->GetUseActivePoints() != 0, "UseActivePoints is on by default");
+  cage->Update();
+  c.Check(std::string(cage->GetStatusString()) == "Ok", "cage with active points: Ok");
+  c.Check(cage->GetEnvelopeComponents() == 2, "with active points the envelope keeps 2 components (got " +
+      Str(cage->GetEnvelopeComponents()) + ")");
+  c.Check(cage->GetEnvelopeGenus() == 1, "and genus 1");
+  c.Check(cage->GetNumberOfActivePoints() > 0, "NumberOfActivePoints > 0");
+  c.Check(std::string(cage->GetTopologyWarning()).empty(), "no topology warning");
+  cage->UseActivePointsOff();
+  cageMessages->Clear();
+  cage->Update();
+  c.Check(std::string(cage->GetStatusString()) == "Ok", "cage without active points: Ok");
+  c.Check(cage->GetEnvelopeComponents() == 1, "without them the parts fuse (1 component)");
+  c.Check(cage->GetNumberOfActivePoints() == 0, "no active points when off");
+  c.Check(!std::string(cage->GetTopologyWarning()).empty(), "a topology warning says so");
+  bool warned = false;
+  for (const std::string& w : cageMessages->Warnings)
+  {
+    warned = warned || w.find("fused") != std::string::npos;
+  }
+  c.Check(warned, "the warning reaches the user as a VTK warning");
+  return c.Result();
+}
+
+//------------------------------------------------------------------------------
+int TestActivePointsErrors(const Context&)
+{
+  Checker c("ActivePointsErrors");
+  vtkNew<vtkActivePointFilter> filter;
+  vtkNew<MessageRecorder> messages;
+  messages->Watch(filter);
+  messages->Watch(filter->GetExecutive());
+  // a sphere: no active points
+  filter->SetInputData(MakeSphere(2.0, 48));
+  filter->Update();
+  c.Check(std::string(filter->GetStatusString()) == "Ok", "sphere: Ok");
+  c.Check(filter->GetNumberOfActivePoints() == 0, "a sphere has no active points");
+  c.Check(messages->Errors.empty(), "no errors on a sphere");
+
+  // an open sphere: an error naming the defect, empty outputs
+  vtkSmartPointer<vtkPolyData> sphere = MakeSphere(1.0, 16);
+  vtkNew<vtkCellArray> polys;
+  vtkIdType npts = 0;
+  const vtkIdType* pts = nullptr;
+  for (vtkIdType cell = 1; cell < sphere->GetPolys()->GetNumberOfCells(); ++cell)
+  {
+    sphere->GetPolys()->GetCellAtId(cell, npts, pts);
+    polys->InsertNextCell(npts, pts);
+  }
+  vtkNew<vtkPolyData> holed;
+  holed->SetPoints(sphere->GetPoints());
+  holed->SetPolys(polys);
+  filter->SetInputData(holed);
+  filter->Update();
+  c.Check(messages->ErrorContains("boundary"), "open input: the error names the boundary edges");
+  c.Check(std::string(filter->GetStatusString()) == "InvalidInput", "status InvalidInput");
+  c.Check(IsEmpty(filter->GetOutput(0)), "empty output on error");
+
+  // empty input: no error, empty output
+  messages->Clear();
+  vtkNew<vtkPolyData> empty;
+  filter->SetInputData(empty);
+  filter->Update();
+  c.Check(messages->Errors.empty(), "empty input is not an error");
+  c.Check(std::string(filter->GetStatusString()) == "EmptyInput", "status EmptyInput");
+
+  // bad parameters: l < r is named
+  messages->Clear();
+  filter->SetInputData(MakeSphere(1.0, 16));
+  filter->SetGeodesicThreshold(0.01);
+  filter->Update();
+  c.Check(messages->ErrorContains("GeodesicThreshold"), "l < r is rejected, naming the parameter");
+  c.Check(IsEmpty(filter->GetOutput(0)), "empty output on bad parameters");
+  return c.Result();
 }
 
 } // namespace sdfcage_test

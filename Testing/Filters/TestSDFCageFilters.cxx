@@ -58,6 +58,8 @@ int main(int argc, char* argv[])
     { "OFFRoundTrip", TestOFFRoundTrip },
     { "OFFVariants", TestOFFVariants },
     { "OFFMalformed", TestOFFMalformed },
+    { "ActivePointsBuiltin", TestActivePointsBuiltin },
+    { "ActivePointsErrors", TestActivePointsErrors },
   };
   if (argc < 3 || cases.find(argv[1]) == cases.end())
   {
