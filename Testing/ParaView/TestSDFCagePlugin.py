@@ -60,6 +60,43 @@ check(cage.GetProperty("TotalTimeInfo").GetElement(0) > 0, "information property
 info = cage.GetDataInformation(0)
 check(info.GetNumberOfPoints() == out.GetNumberOfPoints(), "data information agrees with Fetch")
 
+# --- active points: the Active Points proxy and the cage's properties ---------------------------
+# Two unit spheres 0.3 apart (0.3 / 2.15 = 0.14 in unit-sphere units): with Active Radius 0.2 the
+# facing caps become active, nothing else.
+left = Sphere(Radius=1.0, Center=[-1.15, 0, 0], ThetaResolution=48, PhiResolution=48)
+right = Sphere(Radius=1.0, Center=[1.15, 0, 0], ThetaResolution=48, PhiResolution=48)
+pair = AppendGeometry(Input=[left, right])
+check("ActivePoints" in globals(), "the plugin defines ActivePoints()")
+ap = ActivePoints(Input=pair)
+check(abs(ap.ActiveRadius - 0.025) < 1e-12 and abs(ap.GeodesicThreshold - 0.15) < 1e-12,
+      "Active Points defaults r 0.025, l 0.15")
+ap.ActiveRadius = 0.2
+ap.GeodesicThreshold = 0.5
+ap.GenerateDistanceFields = 1
+ap.UpdatePipeline()
+apo = servermanager.Fetch(ap)
+arr = apo.GetPointData().GetArray("ActivePoint")
+check(arr is not None, "ActivePoint array on the mesh")
+check(apo.GetPointData().GetArray("GeodesicDistanceToActive") is not None, "GeodesicDistanceToActive array")
+check(apo.GetPointData().GetArray("Amplification") is not None, "Amplification array")
+if arr is not None:
+    n_active = sum(int(arr.GetValue(i)) for i in range(arr.GetNumberOfTuples()))
+    facing = all(abs(apo.GetPoint(i)[0]) < 0.6 for i in range(arr.GetNumberOfTuples()) if arr.GetValue(i))
+    print("active points:", n_active)
+    check(n_active > 0, "the facing caps have active points")
+    check(facing, "only points near the gap are active")
+ap.UpdatePropertyInformation()
+check(ap.GetProperty("NumberOfActivePointsInfo").GetElement(0) > 0, "information NumberOfActivePointsInfo")
+apf = servermanager.Fetch(ap, idx=1)
+check(apf.IsA("vtkImageData") and apf.GetPointData().GetArray("ModifiedSignedDistance") is not None,
+      "output 1 has ModifiedSignedDistance")
+check(cage.UseActivePoints == 1, "SDF Cage: Use Active Points on by default")
+fresh = ActivePoints(Input=pair)
+for name in ("ActiveRadius", "GeodesicThreshold", "AmplificationAlpha", "AmplificationBeta"):
+    check(abs(getattr(cage, name) - getattr(fresh, name)) < 1e-12,
+          "SDF Cage and Active Points share the default %s" % name)
+Delete(fresh)
+
 # --- an open input: error, empty output, no crash ----------------------------------------------
 plane = Plane(XResolution=4, YResolution=4)  # an open sheet: 16 boundary edges
 bad = SDFCage(Input=plane)
