@@ -130,43 +130,48 @@ TriangleMesh outerBoundary(const TriangleMesh& surface, int& removed)
 }
 
 
+/// Flags every triangle of `surface` that crosses another one (beyond shared vertices/edges).
+void markSelfIntersecting(const TriangleMesh& surface, std::vector<char>& bad)
+{
+  const std::size_t nf = surface.Triangles.size();
+  bad.resize(nf, 0);
+  TriangleIndex index;
+  index.build(surface);
+  const double foldCosine = -1.0 + 1e-12;
+  const auto box = bounds(surface);
+  const double touching = 1e-12 * std::max(1.0, (box[1] - box[0]).norm());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t f = r.begin(); f != r.end(); ++f)
+    {
+      const Triangle& t = surface.Triangles[f];
+      const int ia[3] = { t[0], t[1], t[2] };
+      const Vec3 pa[3] = { surface.Points[t[0]], surface.Points[t[1]], surface.Points[t[2]] };
+      const Vec3 lo = pa[0].cwiseMin(pa[1]).cwiseMin(pa[2]);
+      const Vec3 hi = pa[0].cwiseMax(pa[1]).cwiseMax(pa[2]);
+      index.forEachTriangleInBox(lo, hi, [&](int g) {
+        if (static_cast<std::size_t>(g) == f || bad[f])
+        {
+          return;
+        }
+        const Triangle& o = surface.Triangles[g];
+        const int ib[3] = { o[0], o[1], o[2] };
+        const Vec3 pb[3] = { surface.Points[o[0]], surface.Points[o[1]], surface.Points[o[2]] };
+        if (trianglesConflict(ia, pa, ib, pb, touching, foldCosine))
+        {
+          bad[f] = 1; // each triangle only writes its own flag
+        }
+      });
+    }
+  });
+}
+
 /// Where a failed surface is wrong: points on every triangle (sampled about one voxel apart)
 /// that crosses another triangle or comes closer than `clearance` to the input.
 std::vector<Vec3> defectLocations(const TriangleMesh& input, const TriangleMesh& surface, double clearance, double voxel)
 {
   const std::size_t nf = surface.Triangles.size();
   std::vector<char> bad(nf, 0);
-  // self-intersections
-  {
-    TriangleIndex index;
-    index.build(surface);
-    const double foldCosine = -1.0 + 1e-12;
-    const auto box = bounds(surface);
-    const double touching = 1e-12 * std::max(1.0, (box[1] - box[0]).norm());
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t f = r.begin(); f != r.end(); ++f)
-      {
-        const Triangle& t = surface.Triangles[f];
-        const int ia[3] = { t[0], t[1], t[2] };
-        const Vec3 pa[3] = { surface.Points[t[0]], surface.Points[t[1]], surface.Points[t[2]] };
-        const Vec3 lo = pa[0].cwiseMin(pa[1]).cwiseMin(pa[2]);
-        const Vec3 hi = pa[0].cwiseMax(pa[1]).cwiseMax(pa[2]);
-        index.forEachTriangleInBox(lo, hi, [&](int g) {
-          if (static_cast<std::size_t>(g) == f || bad[f])
-          {
-            return;
-          }
-          const Triangle& o = surface.Triangles[g];
-          const int ib[3] = { o[0], o[1], o[2] };
-          const Vec3 pb[3] = { surface.Points[o[0]], surface.Points[o[1]], surface.Points[o[2]] };
-          if (trianglesConflict(ia, pa, ib, pb, touching, foldCosine))
-          {
-            bad[f] = 1; // each triangle only writes its own flag
-          }
-        });
-      }
-    });
-  }
+  markSelfIntersecting(surface, bad);
   // clearance
   {
     const TriangleTree tree(input);
@@ -219,6 +224,7 @@ std::size_t projectOntoAmplifiedOffset(
 {
   std::vector<char> amplified;
   std::vector<double> offset; // distance to the input after the projection
+  std::vector<Vec3> original = envelope.Points; // where the grid put them (midpoints: of the chord)
   std::atomic<std::size_t> moved{ 0 };
   auto project = [&](std::size_t begin) {
     amplified.resize(envelope.Points.size(), 0);
@@ -246,6 +252,7 @@ std::size_t projectOntoAmplifiedOffset(
             const double mid = 0.5 * (lo + hi);
             (amp.amplificationAt(t, cp, mid) * mid < c ? lo : hi) = mid;
           }
+          original[i] = x;
           x = cp + (x - cp) * (hi / d);
           amplified[i] = 1;
           offset[i] = hi;
@@ -272,7 +279,43 @@ std::size_t projectOntoAmplifiedOffset(
     {
       break;
     }
+    original.resize(envelope.Points.size());
+    for (std::size_t i = before; i < envelope.Points.size(); ++i)
+    {
+      original[i] = envelope.Points[i];
+    }
     project(before);
+  }
+  // Moving vertices along diverging or converging normals can fold the surface in tight concave
+  // places: there, the vertices go back to where the grid put them (verification decides whether
+  // that is good enough).
+  for (int round = 0; round < 4; ++round)
+  {
+    std::vector<char> bad;
+    markSelfIntersecting(envelope, bad);
+    std::size_t restored = 0;
+    for (std::size_t f = 0; f < bad.size(); ++f)
+    {
+      if (!bad[f])
+      {
+        continue;
+      }
+      for (int k = 0; k < 3; ++k)
+      {
+        const int v = envelope.Triangles[f][k];
+        if (amplified[v])
+        {
+          envelope.Points[v] = original[v];
+          amplified[v] = 0;
+          ++restored;
+        }
+      }
+    }
+    if (restored == 0)
+    {
+      break;
+    }
+    moved -= restored;
   }
   return moved.load();
 }
