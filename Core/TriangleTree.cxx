@@ -163,7 +163,7 @@ double TriangleTree::distance(const Vec3& p) const
   return d;
 }
 
-double TriangleTree::triangleQuery(const Vec3 t[3], double limit, bool stopAtFirst) const
+double TriangleTree::triangleQuery(const Vec3 t[3], double limit, bool stopAtFirst, std::vector<int>* within) const
 {
   if (Nodes.empty())
   {
@@ -220,6 +220,15 @@ double TriangleTree::triangleQuery(const Vec3 t[3], double limit, bool stopAtFir
         }
       }
       const double d = std::sqrt(triangleTriangleDistance2(t, o.P));
+      if (within)
+      {
+        // collect every triangle below the limit; the limit never shrinks
+        if (d < best)
+        {
+          within->push_back(o.Id);
+        }
+        continue;
+      }
       if (d < best)
       {
         best = d;
@@ -241,6 +250,11 @@ double TriangleTree::triangleDistance(const Vec3 t[3], double limit) const
 bool TriangleTree::anyCloserThan(const Vec3 t[3], double delta) const
 {
   return this->triangleQuery(t, delta, true) < delta;
+}
+
+void TriangleTree::trianglesWithin(const Vec3 t[3], double radius, std::vector<int>& ids) const
+{
+  this->triangleQuery(t, radius, false, &ids);
 }
 
 } // namespace sdfcage

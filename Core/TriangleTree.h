@@ -25,6 +25,8 @@ public:
   double triangleDistance(const Vec3 t[3], double limit) const;
   /// True when some mesh triangle comes closer than `delta` to triangle t (stops at the first).
   bool anyCloserThan(const Vec3 t[3], double delta) const;
+  /// Appends to `ids` the mesh triangles closer than `radius` to triangle t (exact distances).
+  void trianglesWithin(const Vec3 t[3], double radius, std::vector<int>& ids) const;
 
   /// Unit normal of mesh triangle `id` (zero for degenerate triangles).
   const Vec3& normal(int id) const { return Normals[id]; }
@@ -47,7 +49,7 @@ private:
     int Id;
   };
   int buildNode(int start, int count, std::vector<Vec3>& centroids, int depth);
-  double triangleQuery(const Vec3 t[3], double limit, bool stopAtFirst) const;
+  double triangleQuery(const Vec3 t[3], double limit, bool stopAtFirst, std::vector<int>* within = nullptr) const;
   std::vector<Node> Nodes;
   std::vector<Tri3> Tri;
   std::vector<Vec3> Normals;
