@@ -124,6 +124,19 @@ double triangleEnergy(const Vec3& a, const Vec3& b, const Vec3& c, const Triangl
   return o.Energy == CageEnergy::Spacing ? spacing(a, b, c, tree, o.TargetSpacing, nullptr) : mips(a, b, c, nullptr);
 }
 
+/// A bounding sphere of a triangle (centroid, farthest corner): distances between two
+/// triangles are at least |c1 - c2| - r1 - r2.
+struct Sphere
+{
+  Vec3 C;
+  double R;
+};
+Sphere boundingSphere(const Vec3& a, const Vec3& b, const Vec3& c)
+{
+  const Vec3 m = (a + b + c) / 3.0;
+  return { m, std::sqrt(std::max({ (a - m).squaredNorm(), (b - m).squaredNorm(), (c - m).squaredNorm() })) };
+}
+
 std::uint64_t edgeKey(int a, int b)
 {
   if (a > b)
@@ -224,6 +237,11 @@ public:
     std::vector<std::array<int, 3>> RingIds; ///< rotated so v comes first
     std::vector<int> InputTris;      ///< input triangles within δ + d̂ + reach of the ring
     std::vector<int> CageTris;       ///< other cage triangles within selfδ + d̂ + reach
+    std::vector<Sphere> InputSpheres, CageSpheres;
+    /// Lower bounds on the distance at P0 between ring triangle i and candidate j (exact where
+    /// it could matter, index i * count + j); the cage one is infinite for pairs sharing a vertex.
+    std::vector<double> InputD0, CageD0;
+    std::vector<Sphere> BTriSpheres;
     // barrier primitives (cage ones share no vertex with the closed star of v)
     std::vector<std::array<Vec3, 3>> BTri; ///< vs the point v
     std::vector<double> BTriMargin;
@@ -274,6 +292,19 @@ public:
     std::sort(L.InputTris.begin(), L.InputTris.end());
     L.InputTris.erase(std::unique(L.InputTris.begin(), L.InputTris.end()), L.InputTris.end());
     const Vec3 lo = ringLo - Vec3::Constant(cageRadius), hi = ringHi + Vec3::Constant(cageRadius);
+    const std::size_t nr = L.RingIds.size();
+    std::vector<Sphere> ringSpheres(nr);
+    for (std::size_t i = 0; i < nr; ++i)
+      ringSpheres[i] = boundingSphere(P[L.RingIds[i][0]], P[L.RingIds[i][1]], P[L.RingIds[i][2]]);
+    // the lower bound of a pair is made exact only when it could limit a move of `reach`
+    auto lowerBound = [&](std::size_t i, const Vec3 q[3], const Sphere& sq, double margin) {
+      const double lb = (sq.C - ringSpheres[i].C).norm() - sq.R - ringSpheres[i].R;
+      if (lb - margin >= reach / AdvanceFraction + dh)
+        return lb;
+      const Vec3 rp[3] = { P[L.RingIds[i][0]], P[L.RingIds[i][1]], P[L.RingIds[i][2]] };
+      return std::sqrt(triangleTriangleDistance2(rp, q));
+    };
+    std::vector<double> d0(nr);
     for (std::size_t f = 0; f < T.size(); ++f)
     {
       if ((Lo[f].array() > hi.array()).any() || (Hi[f].array() < lo.array()).any())
@@ -282,18 +313,41 @@ public:
       if (t[0] == v || t[1] == v || t[2] == v)
         continue;
       const Vec3 pts[3] = { P[t[0]], P[t[1]], P[t[2]] };
+      const Sphere sf = boundingSphere(pts[0], pts[1], pts[2]);
       bool near = false;
-      for (const auto& ids : L.RingIds)
+      for (std::size_t i = 0; i < nr; ++i)
       {
-        const Vec3 rp[3] = { P[ids[0]], P[ids[1]], P[ids[2]] };
-        if (triangleTriangleDistance2(rp, pts) < cageRadius * cageRadius)
-        {
-          near = true;
-          break;
-        }
+        const auto& ids = L.RingIds[i];
+        const bool shares = t[0] == ids[1] || t[0] == ids[2] || t[1] == ids[1] || t[1] == ids[2] ||
+          t[2] == ids[1] || t[2] == ids[2];
+        d0[i] = lowerBound(i, pts, sf, SelfDelta);
+        near = near || d0[i] < cageRadius;
+        if (shares)
+          d0[i] = Inf;
       }
       if (near)
+      {
         L.CageTris.push_back(static_cast<int>(f));
+        L.CageSpheres.push_back(sf);
+        L.CageD0.insert(L.CageD0.end(), d0.begin(), d0.end());
+      }
+    }
+    const std::size_t nc = L.CageTris.size();
+    // CageD0 was filled candidate-major: transpose to ring-major
+    std::vector<double> cd(nr * nc);
+    for (std::size_t j = 0; j < nc; ++j)
+      for (std::size_t i = 0; i < nr; ++i)
+        cd[i * nc + j] = L.CageD0[j * nr + i];
+    L.CageD0.swap(cd);
+    const std::size_t ni = L.InputTris.size();
+    L.InputD0.resize(nr * ni);
+    for (std::size_t j = 0; j < ni; ++j)
+    {
+      const Triangle& t = Input.Triangles[L.InputTris[j]];
+      const Vec3 q[3] = { Input.Points[t[0]], Input.Points[t[1]], Input.Points[t[2]] };
+      L.InputSpheres.push_back(boundingSphere(q[0], q[1], q[2]));
+      for (std::size_t i = 0; i < nr; ++i)
+        L.InputD0[i * ni + j] = lowerBound(i, q, L.InputSpheres[j], Delta);
     }
 
     // barrier primitives, each counted once
@@ -306,6 +360,7 @@ public:
       const Triangle& t = Input.Triangles[f];
       L.BTri.push_back({ Input.Points[t[0]], Input.Points[t[1]], Input.Points[t[2]] });
       L.BTriMargin.push_back(Delta);
+      L.BTriSpheres.push_back(boundingSphere(Input.Points[t[0]], Input.Points[t[1]], Input.Points[t[2]]));
       for (int k = 0; k < 3; ++k)
       {
         edges.push_back({ edgeKey(t[k], t[(k + 1) % 3]), 0 });
@@ -319,6 +374,7 @@ public:
         continue;
       L.BTri.push_back({ P[t[0]], P[t[1]], P[t[2]] });
       L.BTriMargin.push_back(SelfDelta);
+      L.BTriSpheres.push_back(boundingSphere(P[t[0]], P[t[1]], P[t[2]]));
       for (int k = 0; k < 3; ++k)
       {
         edges.push_back({ edgeKey(t[k], t[(k + 1) % 3]), 1 });
@@ -345,26 +401,37 @@ public:
 
   /// Smallest gap (distance minus the distance the pair must keep) between the ring at v = p and
   /// the gathered input and cage triangles (cage ones sharing no vertex with the ring triangle).
-  double minimumGap(const Local& L, const Vec3& p) const
+  /// Gaps at or above `enough` are not resolved exactly (the caller needs no more). A pair's
+  /// distance at p is at least its distance at P0 minus |p - P0| (1-Lipschitz, see advance()).
+  double minimumGap(const Local& L, const Vec3& p, double enough) const
   {
-    double gap = Inf;
-    for (const auto& ids : L.RingIds)
+    double gap = enough;
+    const double moved = (p - L.P0).norm();
+    const std::size_t ni = L.InputTris.size(), nc = L.CageTris.size();
+    for (std::size_t r = 0; r < L.RingIds.size(); ++r)
     {
+      const auto& ids = L.RingIds[r];
       const Vec3 rp[3] = { p, P[ids[1]], P[ids[2]] };
-      for (int f : L.InputTris)
+      const Sphere sr = boundingSphere(rp[0], rp[1], rp[2]);
+      for (std::size_t i = 0; i < ni; ++i)
       {
-        const Triangle& t = Input.Triangles[f];
+        if (L.InputD0[r * ni + i] - moved - Delta >= gap)
+          continue;
+        const Sphere& sq = L.InputSpheres[i];
+        if ((sq.C - sr.C).norm() - sq.R - sr.R - Delta >= gap)
+          continue;
+        const Triangle& t = Input.Triangles[L.InputTris[i]];
         const Vec3 q[3] = { Input.Points[t[0]], Input.Points[t[1]], Input.Points[t[2]] };
         gap = std::min(gap, std::sqrt(triangleTriangleDistance2(rp, q)) - Delta);
       }
-      for (int f : L.CageTris)
+      for (std::size_t i = 0; i < nc; ++i)
       {
-        const Triangle& t = T[f];
-        bool shares = false;
-        for (int a : t)
-          shares = shares || a == ids[1] || a == ids[2];
-        if (shares)
+        if (L.CageD0[r * nc + i] - moved - SelfDelta >= gap) // also skips pairs sharing a vertex
           continue;
+        const Sphere& sq = L.CageSpheres[i];
+        if ((sq.C - sr.C).norm() - sq.R - sr.R - SelfDelta >= gap)
+          continue;
+        const Triangle& t = T[L.CageTris[i]];
         const Vec3 q[3] = { P[t[0]], P[t[1]], P[t[2]] };
         gap = std::min(gap, std::sqrt(triangleTriangleDistance2(rp, q)) - SelfDelta);
       }
@@ -386,7 +453,9 @@ public:
     double t = 0.0;
     for (int k = 0; k < MaximumSubsteps; ++k)
     {
-      const double gap = minimumGap(L, L.P0 + t * move);
+      // gaps beyond the rest of the move (with the sub-step factor) allow it whole
+      const double rest = (1.0 - t) * len / AdvanceFraction;
+      const double gap = minimumGap(L, L.P0 + t * move, rest * (1.0 + 1e-9) + 1e-300);
       if (!(gap > 0))
         return k == 0 ? 0.0 : t; // only at the start (a given cage that already violates a margin)
       const double s = AdvanceFraction * gap / len;
@@ -431,6 +500,8 @@ public:
       for (std::size_t i = 0; i < L.BTri.size(); ++i)
       {
         const auto& q = L.BTri[i];
+        if ((p - L.BTriSpheres[i].C).norm() - L.BTriSpheres[i].R - L.BTriMargin[i] >= dh)
+          continue;
         const Vec3 y = closestPointOnTriangle(p, q[0], q[1], q[2]);
         const double d = (p - y).norm();
         add(d, L.BTriMargin[i], d > 0 ? Vec3((p - y) / d) : Vec3(Vec3::Zero()));
@@ -439,8 +510,13 @@ public:
       for (const auto& ids : L.RingIds)
       {
         const Vec3& w = P[ids[1]]; // each edge (v, w) is the first edge of exactly one ring triangle
+        const Vec3 mid = 0.5 * (p + w);
+        const double half = 0.5 * (w - p).norm();
         for (std::size_t i = 0; i < L.BEdge.size(); ++i)
         {
+          const Vec3 emid = 0.5 * (L.BEdge[i][0] + L.BEdge[i][1]);
+          if ((emid - mid).norm() - half - 0.5 * (L.BEdge[i][1] - L.BEdge[i][0]).norm() - L.BEdgeMargin[i] >= dh)
+            continue;
           double s, t;
           const double d = std::sqrt(segmentSegmentClosest(p, w, L.BEdge[i][0], L.BEdge[i][1], s, t));
           const Vec3 x = p + s * (w - p), y = L.BEdge[i][0] + t * (L.BEdge[i][1] - L.BEdge[i][0]);
@@ -453,9 +529,12 @@ public:
         const Vec3& a = P[ids[1]];
         const Vec3& b = P[ids[2]];
         const double full = (a - p).cross(b - p).norm();
+        const Sphere sr = boundingSphere(p, a, b);
         for (std::size_t i = 0; i < L.BPoint.size(); ++i)
         {
           const Vec3& q = L.BPoint[i];
+          if ((q - sr.C).norm() - sr.R - L.BPointMargin[i] >= dh)
+            continue;
           const Vec3 x = closestPointOnTriangle(q, p, a, b);
           const double d = (x - q).norm();
           const double wv = full > 0 ? (a - x).cross(b - x).norm() / full : 1.0 / 3.0;
@@ -519,6 +598,16 @@ public:
       const Triangle& t = T[f];
       const int tid[3] = { t[0], t[1], t[2] };
       const Vec3 tp[3] = { P[t[0]], P[t[1]], P[t[2]] };
+      bool disjoint = true;
+      for (int a : tid)
+        disjoint = disjoint && a != ids[0] && a != ids[1] && a != ids[2];
+      if (disjoint)
+      {
+        // disjoint triangles whose bounding spheres are farther apart than SelfDelta cannot conflict
+        const Sphere s1 = boundingSphere(pts[0], pts[1], pts[2]), s2 = boundingSphere(tp[0], tp[1], tp[2]);
+        if ((s1.C - s2.C).norm() - s1.R - s2.R >= SelfDelta)
+          continue;
+      }
       if (trianglesConflict(ids, pts, tid, tp, SelfDelta, FoldCosine))
         return false;
     }
