@@ -27,9 +27,8 @@ constexpr double Inf = std::numeric_limits<double>::infinity();
 // Neighbouring cage triangles whose dihedral angle closes below ~18 degrees count as folded (the
 // simplifier's threshold).
 constexpr double FoldCosine = -0.95;
-// Conservative advancement: each sub-step covers this fraction of the current gap.
-constexpr double AdvanceFraction = 0.9;
-constexpr int MaximumSubsteps = 16;
+// Bisection steps of the continuous collision detection when a whole move is not clear.
+constexpr int BisectionSteps = 10;
 // Backtracking halvings of the line search.
 constexpr int LineSearchTries = 8;
 // The first trial step of the line search, relative to the mean edge length around the vertex.
@@ -165,6 +164,15 @@ public:
         VT[v].push_back(static_cast<int>(f));
     Lo.resize(T.size());
     Hi.resize(T.size());
+    std::vector<int> component;
+    const int components = triangleComponents(input, component);
+    std::vector<char> seen(static_cast<std::size_t>(std::max(0, components)), 0);
+    for (std::size_t f = 0; f < input.Triangles.size(); ++f)
+      if (!seen[component[f]])
+      {
+        seen[component[f]] = 1;
+        Representatives.push_back(input.Points[input.Triangles[f][0]]);
+      }
     for (std::size_t f = 0; f < T.size(); ++f)
       updateBox(static_cast<int>(f));
   }
@@ -228,27 +236,44 @@ public:
 
   // ---- continuous collision detection (also used through collisionFreeFraction) ---------------
 
-  /// Everything near vertex v that a move of length up to `reach` can involve.
+  /// Barrier primitives, each counted once: triangles (vs the point v), edges (vs the edges
+  /// (v, w)) and points (vs the ring triangles), each with the distance its pair must keep.
+  struct Primitives
+  {
+    std::vector<std::array<Vec3, 3>> Tri;
+    std::vector<Sphere> TriSpheres;
+    std::vector<double> TriMargin;
+    std::vector<std::array<Vec3, 2>> Edge;
+    std::vector<double> EdgeMargin;
+    std::vector<Vec3> Point;
+    std::vector<double> PointMargin;
+    void clear()
+    {
+      Tri.clear();
+      TriSpheres.clear();
+      TriMargin.clear();
+      Edge.clear();
+      EdgeMargin.clear();
+      Point.clear();
+      PointMargin.clear();
+    }
+  };
+
+  /// Everything near vertex v that a move of length up to `reach` can involve. The input is not
+  /// gathered: its distances come from the tree at each position.
   struct Local
   {
     int V = -1;
     Vec3 P0;
     std::vector<int> Ring;           ///< triangles around v
     std::vector<std::array<int, 3>> RingIds; ///< rotated so v comes first
-    std::vector<int> InputTris;      ///< input triangles within δ + d̂ + reach of the ring
     std::vector<int> CageTris;       ///< other cage triangles within selfδ + d̂ + reach
-    std::vector<Sphere> InputSpheres, CageSpheres;
-    /// Lower bounds on the distance at P0 between ring triangle i and candidate j (exact where
-    /// it could matter, index i * count + j); the cage one is infinite for pairs sharing a vertex.
-    std::vector<double> InputD0, CageD0;
-    std::vector<Sphere> BTriSpheres;
-    // barrier primitives (cage ones share no vertex with the closed star of v)
-    std::vector<std::array<Vec3, 3>> BTri; ///< vs the point v
-    std::vector<double> BTriMargin;
-    std::vector<std::array<Vec3, 2>> BEdge; ///< vs the edges (v, w)
-    std::vector<double> BEdgeMargin;
-    std::vector<Vec3> BPoint;         ///< vs the ring triangles
-    std::vector<double> BPointMargin;
+    std::vector<Sphere> CageSpheres;
+    /// Lower bounds on the distance at P0 between ring triangle i and cage candidate j (exact
+    /// where it could matter, index i * count + j); infinite for pairs sharing a vertex.
+    std::vector<double> CageD0;
+    /// Cage barrier primitives: those of candidates sharing no vertex with the closed star of v.
+    Primitives CageBarrier;
     double MeanEdge = 0.0;
   };
 
@@ -276,21 +301,17 @@ public:
     auto inStar = [&](int w) { return std::binary_search(star.begin(), star.end(), w); };
 
     const double dh = std::max(0.0, Opt.BarrierDistance);
-    const double inputRadius = Delta + dh + reach;
     const double cageRadius = SelfDelta + dh + reach;
     Vec3 ringLo = Vec3::Constant(Inf), ringHi = -ringLo;
     for (const auto& ids : L.RingIds)
     {
-      Vec3 pts[3] = { P[ids[0]], P[ids[1]], P[ids[2]] };
-      Tree.trianglesWithin(pts, inputRadius, L.InputTris);
+      const Vec3 pts[3] = { P[ids[0]], P[ids[1]], P[ids[2]] };
       for (const Vec3& q : pts)
       {
         ringLo = ringLo.cwiseMin(q);
         ringHi = ringHi.cwiseMax(q);
       }
     }
-    std::sort(L.InputTris.begin(), L.InputTris.end());
-    L.InputTris.erase(std::unique(L.InputTris.begin(), L.InputTris.end()), L.InputTris.end());
     const Vec3 lo = ringLo - Vec3::Constant(cageRadius), hi = ringHi + Vec3::Constant(cageRadius);
     const std::size_t nr = L.RingIds.size();
     std::vector<Sphere> ringSpheres(nr);
@@ -299,7 +320,7 @@ public:
     // the lower bound of a pair is made exact only when it could limit a move of `reach`
     auto lowerBound = [&](std::size_t i, const Vec3 q[3], const Sphere& sq, double margin) {
       const double lb = (sq.C - ringSpheres[i].C).norm() - sq.R - ringSpheres[i].R;
-      if (lb - margin >= reach / AdvanceFraction + dh)
+      if (lb - margin >= reach + dh)
         return lb;
       const Vec3 rp[3] = { P[L.RingIds[i][0]], P[L.RingIds[i][1]], P[L.RingIds[i][2]] };
       return std::sqrt(triangleTriangleDistance2(rp, q));
@@ -339,131 +360,188 @@ public:
       for (std::size_t i = 0; i < nr; ++i)
         cd[i * nc + j] = L.CageD0[j * nr + i];
     L.CageD0.swap(cd);
-    const std::size_t ni = L.InputTris.size();
-    L.InputD0.resize(nr * ni);
-    for (std::size_t j = 0; j < ni; ++j)
-    {
-      const Triangle& t = Input.Triangles[L.InputTris[j]];
-      const Vec3 q[3] = { Input.Points[t[0]], Input.Points[t[1]], Input.Points[t[2]] };
-      L.InputSpheres.push_back(boundingSphere(q[0], q[1], q[2]));
-      for (std::size_t i = 0; i < nr; ++i)
-        L.InputD0[i * ni + j] = lowerBound(i, q, L.InputSpheres[j], Delta);
-    }
-
-    // barrier primitives, each counted once
+    // cage barrier primitives
     if (!(dh > 0))
       return;
-    std::vector<std::pair<std::uint64_t, int>> edges; // key, 0 input / 1 cage
-    std::vector<std::pair<int, int>> points;          // id, 0 input / 1 cage
-    for (int f : L.InputTris)
-    {
-      const Triangle& t = Input.Triangles[f];
-      L.BTri.push_back({ Input.Points[t[0]], Input.Points[t[1]], Input.Points[t[2]] });
-      L.BTriMargin.push_back(Delta);
-      L.BTriSpheres.push_back(boundingSphere(Input.Points[t[0]], Input.Points[t[1]], Input.Points[t[2]]));
-      for (int k = 0; k < 3; ++k)
-      {
-        edges.push_back({ edgeKey(t[k], t[(k + 1) % 3]), 0 });
-        points.push_back({ t[k], 0 });
-      }
-    }
+    std::vector<int> far;
     for (int f : L.CageTris)
     {
       const Triangle& t = T[f];
-      if (inStar(t[0]) || inStar(t[1]) || inStar(t[2]))
-        continue;
-      L.BTri.push_back({ P[t[0]], P[t[1]], P[t[2]] });
-      L.BTriMargin.push_back(SelfDelta);
-      L.BTriSpheres.push_back(boundingSphere(P[t[0]], P[t[1]], P[t[2]]));
+      if (!inStar(t[0]) && !inStar(t[1]) && !inStar(t[2]))
+        far.push_back(f);
+    }
+    primitives(far, T, P, SelfDelta, L.CageBarrier);
+  }
+
+  /// Barrier primitives of the triangles `tris` of a mesh (triangles, points): every triangle,
+  /// every edge and every point once.
+  void primitives(const std::vector<int>& tris, const std::vector<Triangle>& triangles,
+    const std::vector<Vec3>& points, double margin, Primitives& out) const
+  {
+    out.clear();
+    std::vector<std::uint64_t>& edges = EdgeScratch;
+    std::vector<int>& ids = PointScratch;
+    edges.clear();
+    ids.clear();
+    for (int f : tris)
+    {
+      const Triangle& t = triangles[f];
+      out.Tri.push_back({ points[t[0]], points[t[1]], points[t[2]] });
+      out.TriSpheres.push_back(boundingSphere(points[t[0]], points[t[1]], points[t[2]]));
+      out.TriMargin.push_back(margin);
       for (int k = 0; k < 3; ++k)
       {
-        edges.push_back({ edgeKey(t[k], t[(k + 1) % 3]), 1 });
-        points.push_back({ t[k], 1 });
+        edges.push_back(edgeKey(t[k], t[(k + 1) % 3]));
+        ids.push_back(t[k]);
       }
     }
     std::sort(edges.begin(), edges.end());
     edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
-    std::sort(points.begin(), points.end());
-    points.erase(std::unique(points.begin(), points.end()), points.end());
-    for (const auto& e : edges)
+    std::sort(ids.begin(), ids.end());
+    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+    for (std::uint64_t e : edges)
     {
-      const int a = static_cast<int>(e.first >> 32), b = static_cast<int>(e.first & 0xFFFFFFFFu);
-      const auto& pts = e.second == 0 ? Input.Points : P;
-      L.BEdge.push_back({ pts[a], pts[b] });
-      L.BEdgeMargin.push_back(e.second == 0 ? Delta : SelfDelta);
+      out.Edge.push_back({ points[static_cast<int>(e >> 32)], points[static_cast<int>(e & 0xFFFFFFFFu)] });
+      out.EdgeMargin.push_back(margin);
     }
-    for (const auto& q : points)
+    for (int q : ids)
     {
-      L.BPoint.push_back(q.second == 0 ? Input.Points[q.first] : P[q.first]);
-      L.BPointMargin.push_back(q.second == 0 ? Delta : SelfDelta);
+      out.Point.push_back(points[q]);
+      out.PointMargin.push_back(margin);
     }
   }
 
-  /// Smallest gap (distance minus the distance the pair must keep) between the ring at v = p and
-  /// the gathered input and cage triangles (cage ones sharing no vertex with the ring triangle).
-  /// Gaps at or above `enough` are not resolved exactly (the caller needs no more). A pair's
-  /// distance at p is at least its distance at P0 minus |p - P0| (1-Lipschitz, see advance()).
-  double minimumGap(const Local& L, const Vec3& p, double enough) const
+  /// Is the straight move of v from P0 to q collision-free? The ring triangle (v, a, b) sweeps
+  /// exactly the tetrahedron conv(P0, q, a, b) (a point of it is (P0 + s (q - P0)) weighted with
+  /// a and b). So no pair comes closer than its margin during the move iff no input triangle and
+  /// no cage triangle sharing no vertex with (v, a, b) comes closer than its margin to the
+  /// tetrahedron: that is, to one of its faces (the face (P0, a, b) is the starting triangle,
+  /// already clear), or lies wholly inside it (then its component's representative point, or for
+  /// the cage its corners, are inside). Exact-in-effect distances (the same double-precision
+  /// triangle-triangle distances as everywhere else).
+  bool sweepClear(const Local& L, const Vec3& q) const
   {
-    double gap = enough;
-    const double moved = (p - L.P0).norm();
-    const std::size_t ni = L.InputTris.size(), nc = L.CageTris.size();
+    const double moved = (q - L.P0).norm();
+    const std::size_t nc = L.CageTris.size();
     for (std::size_t r = 0; r < L.RingIds.size(); ++r)
     {
       const auto& ids = L.RingIds[r];
-      const Vec3 rp[3] = { p, P[ids[1]], P[ids[2]] };
-      const Sphere sr = boundingSphere(rp[0], rp[1], rp[2]);
-      for (std::size_t i = 0; i < ni; ++i)
-      {
-        if (L.InputD0[r * ni + i] - moved - Delta >= gap)
-          continue;
-        const Sphere& sq = L.InputSpheres[i];
-        if ((sq.C - sr.C).norm() - sq.R - sr.R - Delta >= gap)
-          continue;
-        const Triangle& t = Input.Triangles[L.InputTris[i]];
-        const Vec3 q[3] = { Input.Points[t[0]], Input.Points[t[1]], Input.Points[t[2]] };
-        gap = std::min(gap, std::sqrt(triangleTriangleDistance2(rp, q)) - Delta);
-      }
+      const Vec3& a = P[ids[1]];
+      const Vec3& b = P[ids[2]];
+      const Vec3 faces[3][3] = { { q, a, b }, { L.P0, q, a }, { L.P0, b, q } };
+      for (const auto& f : faces)
+        if (Tree.anyCloserThan(f, Delta))
+          return false;
+      const double volume = (q - L.P0).dot((a - L.P0).cross(b - L.P0));
+      const bool solid = std::abs(volume) > 1e-14 * std::pow(std::max({ moved, (a - L.P0).norm(), (b - L.P0).norm() }), 3);
+      auto inside = [&](const Vec3& x) {
+        if (!solid)
+          return false;
+        const double s0 = (a - x).dot((b - x).cross(q - x)); // opposite P0
+        const double s1 = (L.P0 - x).dot((b - x).cross(a - x)); // opposite q
+        const double s2 = (L.P0 - x).dot((q - x).cross(b - x)); // opposite a
+        const double s3 = (L.P0 - x).dot((a - x).cross(q - x)); // opposite b
+        return (s0 >= 0 && s1 >= 0 && s2 >= 0 && s3 >= 0) || (s0 <= 0 && s1 <= 0 && s2 <= 0 && s3 <= 0);
+      };
+      for (const Vec3& x : Representatives)
+        if (inside(x))
+          return false;
       for (std::size_t i = 0; i < nc; ++i)
       {
-        if (L.CageD0[r * nc + i] - moved - SelfDelta >= gap) // also skips pairs sharing a vertex
-          continue;
-        const Sphere& sq = L.CageSpheres[i];
-        if ((sq.C - sr.C).norm() - sq.R - sr.R - SelfDelta >= gap)
+        // the tetrahedron lies within `moved` of the starting triangle; also skips pairs
+        // sharing a vertex (infinite bound)
+        if (L.CageD0[r * nc + i] - moved - SelfDelta >= 0)
           continue;
         const Triangle& t = T[L.CageTris[i]];
-        const Vec3 q[3] = { P[t[0]], P[t[1]], P[t[2]] };
-        gap = std::min(gap, std::sqrt(triangleTriangleDistance2(rp, q)) - SelfDelta);
+        const Vec3 c[3] = { P[t[0]], P[t[1]], P[t[2]] };
+        for (const auto& f : faces)
+          if (triangleTriangleDistance2(f, c) < SelfDelta * SelfDelta)
+            return false;
+        for (const Vec3& x : c)
+          if (inside(x))
+            return false;
       }
     }
-    return gap;
+    return true;
   }
 
-  /// Conservative advancement. Every point of a ring triangle moves by its barycentric weight of
-  /// v times the displacement of v, so by at most |move| t over a fraction t of the move: every
-  /// pair distance is 1-Lipschitz in |move| t. From a position whose smallest gap is g > 0, a
-  /// sub-step of length AdvanceFraction * g therefore keeps every gap >= (1 - AdvanceFraction) g
-  /// > 0 along the whole sub-step; pairs not gathered start farther than their margin + reach and
-  /// cannot close in. The result is the sum of the sub-steps (at most MaximumSubsteps).
+  /// The largest fraction t of the move (to 1/1024) for which the move to P0 + t move is
+  /// collision-free: the whole move if it is, else a bisection (a fraction is clear iff its
+  /// tetrahedra are, and they grow with t, so clear fractions form an interval [0, t*]).
   double advance(const Local& L, const Vec3& move) const
   {
-    const double len = move.norm();
-    if (!(len > 0))
+    if (!(move.norm() > 0) || sweepClear(L, L.P0 + move))
       return 1.0;
-    double t = 0.0;
-    for (int k = 0; k < MaximumSubsteps; ++k)
+    double lo = 0.0, hi = 1.0;
+    for (int k = 0; k < BisectionSteps; ++k)
     {
-      // gaps beyond the rest of the move (with the sub-step factor) allow it whole
-      const double rest = (1.0 - t) * len / AdvanceFraction;
-      const double gap = minimumGap(L, L.P0 + t * move, rest * (1.0 + 1e-9) + 1e-300);
-      if (!(gap > 0))
-        return k == 0 ? 0.0 : t; // only at the start (a given cage that already violates a margin)
-      const double s = AdvanceFraction * gap / len;
-      if (t + s >= 1.0)
-        return 1.0;
-      t += s;
+      const double mid = 0.5 * (lo + hi);
+      if (sweepClear(L, L.P0 + mid * move))
+        lo = mid;
+      else
+        hi = mid;
     }
-    return t;
+    return lo;
+  }
+
+  /// Adds the barrier of the pairs between the primitives and the ring of v at p to B (and its
+  /// gradient with respect to p to gb).
+  void barrierTerms(const Local& L, const Primitives& prims, const Vec3& p, double dh, bool withGradient,
+    double& B, Vec3& gb) const
+  {
+    auto add = [&](double d, double margin, const Vec3& dddp) {
+      const double gap = d - margin;
+      if (gap >= dh)
+        return;
+      B += barrier(gap, dh);
+      if (withGradient)
+        gb += barrierDerivative(gap, dh) * dddp;
+    };
+    // point v vs triangles
+    for (std::size_t i = 0; i < prims.Tri.size(); ++i)
+    {
+      const auto& q = prims.Tri[i];
+      if ((p - prims.TriSpheres[i].C).norm() - prims.TriSpheres[i].R - prims.TriMargin[i] >= dh)
+        continue;
+      const Vec3 y = closestPointOnTriangle(p, q[0], q[1], q[2]);
+      const double d = (p - y).norm();
+      add(d, prims.TriMargin[i], d > 0 ? Vec3((p - y) / d) : Vec3(Vec3::Zero()));
+    }
+    // edges (v, w) vs edges; each edge (v, w) is the first edge of exactly one ring triangle
+    for (const auto& ids : L.RingIds)
+    {
+      const Vec3& w = P[ids[1]];
+      const Vec3 mid = 0.5 * (p + w);
+      const double half = 0.5 * (w - p).norm();
+      for (std::size_t i = 0; i < prims.Edge.size(); ++i)
+      {
+        const auto& e = prims.Edge[i];
+        if ((0.5 * (e[0] + e[1]) - mid).norm() - half - 0.5 * (e[1] - e[0]).norm() - prims.EdgeMargin[i] >= dh)
+          continue;
+        double s, t;
+        const double d = std::sqrt(segmentSegmentClosest(p, w, e[0], e[1], s, t));
+        const Vec3 x = p + s * (w - p), y = e[0] + t * (e[1] - e[0]);
+        add(d, prims.EdgeMargin[i], d > 0 ? Vec3((1.0 - s) * (x - y) / d) : Vec3(Vec3::Zero()));
+      }
+    }
+    // ring triangles vs points
+    for (const auto& ids : L.RingIds)
+    {
+      const Vec3& a = P[ids[1]];
+      const Vec3& b = P[ids[2]];
+      const double full = (a - p).cross(b - p).norm();
+      const Sphere sr = boundingSphere(p, a, b);
+      for (std::size_t i = 0; i < prims.Point.size(); ++i)
+      {
+        const Vec3& q = prims.Point[i];
+        if ((q - sr.C).norm() - sr.R - prims.PointMargin[i] >= dh)
+          continue;
+        const Vec3 x = closestPointOnTriangle(q, p, a, b);
+        const double d = (x - q).norm();
+        const double wv = full > 0 ? (a - x).cross(b - x).norm() / full : 1.0 / 3.0;
+        add(d, prims.PointMargin[i], d > 0 ? Vec3(wv * (x - q) / d) : Vec3(Vec3::Zero()));
+      }
+    }
   }
 
   // ---- energy of one vertex -------------------------------------------------------------------
@@ -488,58 +566,20 @@ public:
     {
       double B = 0.0;
       Vec3 gb = Vec3::Zero();
-      auto add = [&](double d, double margin, const Vec3& dddp) {
-        const double gap = d - margin;
-        if (gap >= dh)
-          return;
-        B += barrier(gap, dh);
-        if (grad)
-          gb += barrierDerivative(gap, dh) * dddp;
-      };
-      // point v vs triangles
-      for (std::size_t i = 0; i < L.BTri.size(); ++i)
-      {
-        const auto& q = L.BTri[i];
-        if ((p - L.BTriSpheres[i].C).norm() - L.BTriSpheres[i].R - L.BTriMargin[i] >= dh)
-          continue;
-        const Vec3 y = closestPointOnTriangle(p, q[0], q[1], q[2]);
-        const double d = (p - y).norm();
-        add(d, L.BTriMargin[i], d > 0 ? Vec3((p - y) / d) : Vec3(Vec3::Zero()));
-      }
-      // edges (v, w) vs edges
+      barrierTerms(L, L.CageBarrier, p, dh, grad != nullptr, B, gb);
+      // the input: only triangles within δ + d̂ of the ring at p can give a non-zero term
+      InputScratch.clear();
       for (const auto& ids : L.RingIds)
       {
-        const Vec3& w = P[ids[1]]; // each edge (v, w) is the first edge of exactly one ring triangle
-        const Vec3 mid = 0.5 * (p + w);
-        const double half = 0.5 * (w - p).norm();
-        for (std::size_t i = 0; i < L.BEdge.size(); ++i)
-        {
-          const Vec3 emid = 0.5 * (L.BEdge[i][0] + L.BEdge[i][1]);
-          if ((emid - mid).norm() - half - 0.5 * (L.BEdge[i][1] - L.BEdge[i][0]).norm() - L.BEdgeMargin[i] >= dh)
-            continue;
-          double s, t;
-          const double d = std::sqrt(segmentSegmentClosest(p, w, L.BEdge[i][0], L.BEdge[i][1], s, t));
-          const Vec3 x = p + s * (w - p), y = L.BEdge[i][0] + t * (L.BEdge[i][1] - L.BEdge[i][0]);
-          add(d, L.BEdgeMargin[i], d > 0 ? Vec3((1.0 - s) * (x - y) / d) : Vec3(Vec3::Zero()));
-        }
+        const Vec3 rp[3] = { p, P[ids[1]], P[ids[2]] };
+        Tree.trianglesWithin(rp, Delta + dh, InputScratch);
       }
-      // ring triangles vs points
-      for (const auto& ids : L.RingIds)
+      if (!InputScratch.empty())
       {
-        const Vec3& a = P[ids[1]];
-        const Vec3& b = P[ids[2]];
-        const double full = (a - p).cross(b - p).norm();
-        const Sphere sr = boundingSphere(p, a, b);
-        for (std::size_t i = 0; i < L.BPoint.size(); ++i)
-        {
-          const Vec3& q = L.BPoint[i];
-          if ((q - sr.C).norm() - sr.R - L.BPointMargin[i] >= dh)
-            continue;
-          const Vec3 x = closestPointOnTriangle(q, p, a, b);
-          const double d = (x - q).norm();
-          const double wv = full > 0 ? (a - x).cross(b - x).norm() / full : 1.0 / 3.0;
-          add(d, L.BPointMargin[i], d > 0 ? Vec3(wv * (x - q) / d) : Vec3(Vec3::Zero()));
-        }
+        std::sort(InputScratch.begin(), InputScratch.end());
+        InputScratch.erase(std::unique(InputScratch.begin(), InputScratch.end()), InputScratch.end());
+        primitives(InputScratch, Input.Triangles, Input.Points, Delta, InputBarrier);
+        barrierTerms(L, InputBarrier, p, dh, grad != nullptr, B, gb);
       }
       e += lambda * B;
       g += lambda * gb;
@@ -742,7 +782,13 @@ private:
   std::vector<Triangle> T;
   std::vector<std::vector<int>> VT;
   std::vector<Vec3> Lo, Hi;
+  std::vector<Vec3> Representatives; ///< one input point per input component
   Local Scratch;
+  // scratch buffers of the const queries (the optimizer is used by one thread)
+  mutable std::vector<int> InputScratch;
+  mutable Primitives InputBarrier;
+  mutable std::vector<std::uint64_t> EdgeScratch;
+  mutable std::vector<int> PointScratch;
 };
 
 } // namespace

@@ -102,10 +102,12 @@ double cageEnergy(const TriangleMesh& cage, const TriangleTree& inputTree, const
 /// Smallest interior angle of the cage's triangles, in degrees.
 double minimumAngle(const TriangleMesh& cage);
 
-/// Continuous collision detection by conservative advancement: the fraction t in [0, 1] of the
-/// move P[v] -> P[v] + move such that, along the whole straight path to P[v] + t move, no triangle
-/// around v comes closer than `clearance` to the input or closer than `selfClearance` to a cage
-/// triangle it shares no vertex with. Exposed for tests; the optimizer uses the same code.
+/// Continuous collision detection: the largest fraction t in [0, 1] (to 1/1024, never above the
+/// true one) of the move P[v] -> P[v] + move such that, along the whole straight path to
+/// P[v] + t move, no triangle around v comes closer than `clearance` to the input or closer than
+/// `selfClearance` to a cage triangle it shares no vertex with. A triangle (v, a, b) sweeps exactly
+/// the tetrahedron (P[v], P[v] + t move, a, b), which is tested with exact-in-effect distances.
+/// Exposed for tests; the optimizer uses the same code.
 double collisionFreeFraction(const TriangleMesh& cage, int v, const Vec3& move, const TriangleMesh& input,
   const TriangleTree& inputTree, double clearance, double selfClearance);
 
