@@ -272,6 +272,9 @@ public:
     /// Lower bounds on the distance at P0 between ring triangle i and cage candidate j (exact
     /// where it could matter, index i * count + j); infinite for pairs sharing a vertex.
     std::vector<double> CageD0;
+    /// Per ring triangle, a lower bound on its distance to the input at P0 (δ + d̂ or 0): the
+    /// input is clear of the ring at q when this minus |q - P0| is large enough.
+    std::vector<double> InputD0;
     /// Cage barrier primitives: those of candidates sharing no vertex with the closed star of v.
     Primitives CageBarrier;
     double MeanEdge = 0.0;
@@ -360,6 +363,13 @@ public:
       for (std::size_t i = 0; i < nr; ++i)
         cd[i * nc + j] = L.CageD0[j * nr + i];
     L.CageD0.swap(cd);
+    for (std::size_t i = 0; i < nr; ++i)
+    {
+      const Vec3 rp[3] = { P[L.RingIds[i][0]], P[L.RingIds[i][1]], P[L.RingIds[i][2]] };
+      // a cheap certificate (the query stops at the first triangle closer than the limit)
+      const double limit = Delta + dh;
+      L.InputD0.push_back(Tree.anyCloserThan(rp, limit) ? 0.0 : limit);
+    }
     // cage barrier primitives
     if (!(dh > 0))
       return;
@@ -429,8 +439,11 @@ public:
       const Vec3& a = P[ids[1]];
       const Vec3& b = P[ids[2]];
       const Vec3 faces[3][3] = { { q, a, b }, { L.P0, q, a }, { L.P0, b, q } };
+      // the tetrahedron lies within `moved` of the starting triangle: if that is far enough from
+      // the input, neither a face nor a whole component can come closer than Delta
+      const bool inputFar = L.InputD0[r] - moved >= Delta;
       for (const auto& f : faces)
-        if (Tree.anyCloserThan(f, Delta))
+        if (!inputFar && Tree.anyCloserThan(f, Delta))
           return false;
       const double volume = (q - L.P0).dot((a - L.P0).cross(b - L.P0));
       const bool solid = std::abs(volume) > 1e-14 * std::pow(std::max({ moved, (a - L.P0).norm(), (b - L.P0).norm() }), 3);
@@ -444,7 +457,7 @@ public:
         return (s0 >= 0 && s1 >= 0 && s2 >= 0 && s3 >= 0) || (s0 <= 0 && s1 <= 0 && s2 <= 0 && s3 <= 0);
       };
       for (const Vec3& x : Representatives)
-        if (inside(x))
+        if (!inputFar && inside(x))
           return false;
       for (std::size_t i = 0; i < nc; ++i)
       {
@@ -569,9 +582,12 @@ public:
       barrierTerms(L, L.CageBarrier, p, dh, grad != nullptr, B, gb);
       // the input: only triangles within δ + d̂ of the ring at p can give a non-zero term
       InputScratch.clear();
-      for (const auto& ids : L.RingIds)
+      const double moved = (p - L.P0).norm();
+      for (std::size_t r = 0; r < L.RingIds.size(); ++r)
       {
-        const Vec3 rp[3] = { p, P[ids[1]], P[ids[2]] };
+        if (L.InputD0[r] - moved >= Delta + dh) // no input within the barrier's reach
+          continue;
+        const Vec3 rp[3] = { p, P[L.RingIds[r][1]], P[L.RingIds[r][2]] };
         Tree.trianglesWithin(rp, Delta + dh, InputScratch);
       }
       if (!InputScratch.empty())
@@ -593,7 +609,9 @@ public:
 
   /// The ring of v at p: no needle or flip, clearance to the input (exact distances through the
   /// tree), no conflict with any other cage triangle (the simplifier's test).
-  bool ringAcceptable(const Local& L, const Vec3& p) const
+  /// `inputChecked`: the input clearance of the ring at p was just established by sweepClear()
+  /// (its tetrahedra have the ring at p as a face, tested with the same anyCloserThan).
+  bool ringAcceptable(const Local& L, const Vec3& p, bool inputChecked) const
   {
     const int n = static_cast<int>(L.RingIds.size());
     std::vector<std::array<Vec3, 3>> pts(n);
@@ -608,7 +626,7 @@ public:
       const double q0 = triangleQuality(L.P0, P[ids[1]], P[ids[2]]);
       if (triangleQuality(p, P[ids[1]], P[ids[2]]) < std::min(Opt.MinimumTriangleQuality, q0))
         return false;
-      if (Tree.anyCloserThan(pts[i].data(), Delta))
+      if (!inputChecked && Tree.anyCloserThan(pts[i].data(), Delta))
         return false;
     }
     for (int i = 0; i < n; ++i)
@@ -674,14 +692,21 @@ public:
     double step = reach;
     for (int k = 0; k < LineSearchTries; ++k, step *= 0.5)
     {
+      // energy first (cheaper than the collision test), then the collision-free fraction
       const Vec3 move = step * dir;
+      Vec3 p = L.P0 + move;
+      if (!(vertexEnergy(L, p, nullptr) < e0))
+        continue;
       const double t = advance(L, move);
       if (!(t > 0))
         return -1;
-      const Vec3 p = L.P0 + t * move;
-      if (!(vertexEnergy(L, p, nullptr) < e0))
-        continue;
-      if (!ringAcceptable(L, p))
+      if (t < 1.0)
+      {
+        p = L.P0 + t * move;
+        if (!(vertexEnergy(L, p, nullptr) < e0))
+          continue;
+      }
+      if (!ringAcceptable(L, p, true))
         continue;
       P[v] = p;
       for (int f : L.Ring)

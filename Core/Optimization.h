@@ -46,7 +46,7 @@ struct OptimizeOptions
   /// Rounds of (one relocation pass over every vertex, then one flip pass if EdgeFlips).
   int NumberOfIterations = 1;
   /// Gradient steps per vertex in one relocation pass.
-  int DescentSteps = 3;
+  int DescentSteps = 2;
   bool EdgeFlips = true;
   /// δ: every cage triangle keeps at least this distance from every input triangle. <= 0 means
   /// automatic: min(0.0025, the measured clearance of the given cage), so a valid cage made with

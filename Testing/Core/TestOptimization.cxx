@@ -11,7 +11,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <iostream>
 
 using namespace sdfcage;
@@ -231,4 +233,46 @@ TEST(Optimization, RejectsCagesThatDoNotEnclose)
   const OptimizeResult c = optimizeCageInInputUnits(makeSphere(Vec3(0, 0, 0), 1.1, 24, 12), input, o);
   EXPECT_EQ(c.State, Status::InvalidInput);
   EXPECT_NE(c.Message.find("closer than the clearance"), std::string::npos) << c.Message;
+}
+
+TEST(Optimization, TreeTriangleQueriesMatchBruteForce)
+{
+  // the tree's pruning (bounding boxes, the query's plane and side planes) must not change the
+  // answers: distances, "any closer" and "all within" against a brute-force loop
+  const TriangleMesh mesh = makeTorus(Vec3(0, 0, 0), 1.0, 0.3, 48, 16);
+  const TriangleTree tree(mesh);
+  unsigned seed = 12345;
+  auto uniform = [&]() {
+    seed = seed * 1664525u + 1013904223u;
+    return (seed >> 8) / double(1u << 24);
+  };
+  int within = 0;
+  for (int trial = 0; trial < 300; ++trial)
+  {
+    const Vec3 c(2.6 * uniform() - 1.3, 2.6 * uniform() - 1.3, 0.8 * uniform() - 0.4);
+    const double size = trial % 3 == 0 ? 0.02 : (trial % 3 == 1 ? 0.2 : 0.8);
+    Vec3 t[3];
+    for (Vec3& p : t)
+      p = c + size * Vec3(uniform() - 0.5, uniform() - 0.5, uniform() - 0.5);
+    const double radius = 0.005 + 0.1 * uniform();
+    double brute = std::numeric_limits<double>::infinity();
+    std::vector<int> expected;
+    for (std::size_t f = 0; f < mesh.Triangles.size(); ++f)
+    {
+      const Vec3 q[3] = { mesh.Points[mesh.Triangles[f][0]], mesh.Points[mesh.Triangles[f][1]],
+        mesh.Points[mesh.Triangles[f][2]] };
+      const double d = std::sqrt(triangleTriangleDistance2(t, q));
+      brute = std::min(brute, d);
+      if (d < radius)
+        expected.push_back(static_cast<int>(f));
+    }
+    EXPECT_DOUBLE_EQ(tree.triangleDistance(t, 1e9), brute) << trial;
+    EXPECT_EQ(tree.anyCloserThan(t, radius), brute < radius) << trial;
+    std::vector<int> got;
+    tree.trianglesWithin(t, radius, got);
+    std::sort(got.begin(), got.end());
+    EXPECT_EQ(got, expected) << trial;
+    within += expected.empty() ? 0 : 1;
+  }
+  EXPECT_GT(within, 30) << "the random queries must exercise non-empty answers";
 }
