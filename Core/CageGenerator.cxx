@@ -138,6 +138,24 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
       result.TotalSeconds = seconds(start);
       return result;
     }
+    // 5. optional optimization (§3.3): it verifies its own result, and keeps the simplified cage
+    // if that ever fails
+    if (options.Optimize && !result.Simplification.Cancelled && !progressCancelled(progress))
+    {
+      OptimizeOptions oo = options.Optimization;
+      oo.Clearance = so.Clearance;
+      result.Optimization = optimizeCage(result.Simplification.Cage, unit, tree, oo, nullptr);
+      result.OptimizationSeconds = result.Optimization.Seconds;
+      if (result.Optimization.State == Status::Ok && !result.Optimization.Reverted)
+      {
+        result.Optimized = true;
+        result.Simplification.Cage = std::move(result.Optimization.Cage);
+        dist = std::move(result.Optimization.DistanceToInput);
+        clearance = result.Optimization.MinimumClearance;
+      }
+      result.Optimization.Cage = TriangleMesh();
+      result.Optimization.DistanceToInput.clear();
+    }
     result.Cage = n.toInput(result.Simplification.Cage);
     result.CageDistanceToInput.resize(dist.size());
     for (std::size_t i = 0; i < dist.size(); ++i)

@@ -27,6 +27,7 @@
 
 #include "CageGenerator.h"
 #include "Progress.h"
+#include "vtkSDFCageInternals.h"
 
 #include <algorithm>
 #include <exception>
@@ -39,188 +40,6 @@ vtkStandardNewMacro(vtkSDFCageFilter);
 
 namespace
 {
-//------------------------------------------------------------------------------
-// Forwards Core's progress to the filter, and the filter's abort flag to Core.
-// Core may call report()/pollCancel() from worker threads; VTK objects are only touched from the
-// thread that runs RequestData (the one that constructed this object). Cancellation still reaches
-// the workers: Progress latches the flag in an atomic once pollCancel() has returned true.
-class FilterProgress final : public sdfcage::Progress
-{
-public:
-  explicit FilterProgress(vtkSDFCageFilter* filter)
-    : Filter(filter)
-    , Owner(std::this_thread::get_id())
-  {
-  }
-
-protected:
-  void report(double overall, const std::string& stage) override
-  {
-    if (std::this_thread::get_id() != this->Owner)
-    {
-      return;
-    }
-    // Throttle: a new stage always shows; inside a stage, report every 1% at most (each
-    // UpdateProgress fires observers, which in ParaView repaint a progress bar).
-    const bool newStage = stage != this->LastStage;
-    if (!newStage && overall < this->LastReported + 0.01)
-    {
-      return;
-    }
-    if (newStage)
-    {
-      this->LastStage = stage;
-      this->Filter->SetProgressText(stage.c_str());
-    }
-    this->LastReported = overall;
-    this->Filter->UpdateProgress(overall);
-  }
-
-  bool pollCancel() override
-  {
-    return std::this_thread::get_id() == this->Owner && this->Filter->GetAbortExecute() != 0;
-  }
-
-private:
-  vtkSDFCageFilter* Filter;
-  std::thread::id Owner;
-  std::string LastStage;
-  double LastReported = -1.0;
-};
-
-//------------------------------------------------------------------------------
-// Appends the cells of `cells` to `mesh`. Polygons are copied as they are (Core triangulates
-// them and reports what it could not split). Triangle strips are split here; the degenerate
-// triangles a strip uses to turn (two equal ids) are an artifact of the encoding, not of the
-// surface, and are skipped. Vertex and line cells are passed as 1- and 2-point cells so that
-// Core counts them as ignored cells.
-enum class CellKind
-{
-  Vertex,
-  Line,
-  Polygon,
-  Strip
-};
-
-void AppendCells(vtkCellArray* cells, CellKind kind, sdfcage::PolygonMesh& mesh)
-{
-  if (!cells || cells->GetNumberOfCells() == 0)
-  {
-    return;
-  }
-  auto it = vtk::TakeSmartPointer(cells->NewIterator());
-  vtkIdType npts = 0;
-  const vtkIdType* pts = nullptr;
-  for (it->GoToFirstCell(); !it->IsDoneWithTraversal(); it->GoToNextCell())
-  {
-    it->GetCurrentCell(npts, pts);
-    switch (kind)
-    {
-      case CellKind::Vertex:
-        if (npts >= 1)
-        {
-          mesh.addCell({ pts[0] });
-        }
-        break;
-      case CellKind::Line:
-        if (npts >= 2)
-        {
-          mesh.addCell({ pts[0], pts[1] });
-        }
-        break;
-      case CellKind::Polygon:
-        mesh.Connectivity.insert(mesh.Connectivity.end(), pts, pts + npts);
-        mesh.Offsets.push_back(static_cast<std::int64_t>(mesh.Connectivity.size()));
-        break;
-      case CellKind::Strip:
-        for (vtkIdType i = 0; i + 2 < npts; ++i)
-        {
-          vtkIdType a = pts[i], b = pts[i + 1];
-          const vtkIdType c = pts[i + 2];
-          if (a == b || b == c || a == c)
-          {
-            continue;
-          }
-          if (i % 2 == 1)
-          {
-            std::swap(a, b); // odd triangles of a strip are wound the other way
-          }
-          mesh.addCell({ a, b, c });
-        }
-        break;
-    }
-  }
-}
-
-void ToPolygonMesh(vtkPolyData* input, sdfcage::PolygonMesh& mesh)
-{
-  const vtkIdType numberOfPoints = input->GetNumberOfPoints();
-  mesh.Points.resize(static_cast<std::size_t>(numberOfPoints));
-  double p[3];
-  for (vtkIdType i = 0; i < numberOfPoints; ++i)
-  {
-    input->GetPoint(i, p);
-    mesh.Points[static_cast<std::size_t>(i)] = sdfcage::Vec3(p[0], p[1], p[2]);
-  }
-  mesh.Offsets.assign(1, 0);
-  mesh.Connectivity.clear();
-  if (vtkCellArray* polys = input->GetPolys())
-  {
-    mesh.Connectivity.reserve(static_cast<std::size_t>(polys->GetNumberOfConnectivityIds()));
-    mesh.Offsets.reserve(static_cast<std::size_t>(polys->GetNumberOfCells()) + 1);
-  }
-  AppendCells(input->GetPolys(), CellKind::Polygon, mesh);
-  AppendCells(input->GetStrips(), CellKind::Strip, mesh);
-  AppendCells(input->GetVerts(), CellKind::Vertex, mesh);
-  AppendCells(input->GetLines(), CellKind::Line, mesh);
-}
-
-void ToPolyData(
-  const sdfcage::TriangleMesh& mesh, const std::vector<double>& distance, vtkPolyData* output)
-{
-  const vtkIdType numberOfPoints = static_cast<vtkIdType>(mesh.numberOfPoints());
-  const vtkIdType numberOfTriangles = static_cast<vtkIdType>(mesh.numberOfTriangles());
-
-  vtkNew<vtkPoints> points;
-  points->SetDataTypeToDouble();
-  points->SetNumberOfPoints(numberOfPoints);
-  for (vtkIdType i = 0; i < numberOfPoints; ++i)
-  {
-    points->SetPoint(i, mesh.Points[static_cast<std::size_t>(i)].data());
-  }
-
-  vtkNew<vtkIdTypeArray> offsets;
-  vtkNew<vtkIdTypeArray> connectivity;
-  offsets->SetNumberOfValues(numberOfTriangles + 1);
-  connectivity->SetNumberOfValues(3 * numberOfTriangles);
-  for (vtkIdType t = 0; t < numberOfTriangles; ++t)
-  {
-    const sdfcage::Triangle& tri = mesh.Triangles[static_cast<std::size_t>(t)];
-    offsets->SetValue(t, 3 * t);
-    connectivity->SetValue(3 * t, tri[0]);
-    connectivity->SetValue(3 * t + 1, tri[1]);
-    connectivity->SetValue(3 * t + 2, tri[2]);
-  }
-  offsets->SetValue(numberOfTriangles, 3 * numberOfTriangles);
-  vtkNew<vtkCellArray> polys;
-  polys->SetData(offsets, connectivity);
-
-  output->SetPoints(points);
-  output->SetPolys(polys);
-
-  if (static_cast<vtkIdType>(distance.size()) == numberOfPoints)
-  {
-    vtkNew<vtkDoubleArray> array;
-    array->SetName("DistanceToInput");
-    array->SetNumberOfValues(numberOfPoints);
-    for (vtkIdType i = 0; i < numberOfPoints; ++i)
-    {
-      array->SetValue(i, distance[static_cast<std::size_t>(i)]);
-    }
-    output->GetPointData()->SetScalars(array);
-  }
-}
-
 void ToImageData(const sdfcage::ScalarImage& field, vtkImageData* output)
 {
   const auto& dims = field.Dimensions;
@@ -240,37 +59,9 @@ void ToImageData(const sdfcage::ScalarImage& field, vtkImageData* output)
   output->GetPointData()->SetScalars(values);
 }
 
-// Machine-readable status identifiers (Core's statusName() is for humans).
-const char* StatusIdentifier(sdfcage::Status status)
-{
-  switch (status)
-  {
-    case sdfcage::Status::Ok:
-      return "Ok";
-    case sdfcage::Status::EmptyInput:
-      return "EmptyInput";
-    case sdfcage::Status::InvalidInput:
-      return "InvalidInput";
-    case sdfcage::Status::Cancelled:
-      return "Cancelled";
-    case sdfcage::Status::VerificationFailed:
-      return "VerificationFailed";
-    case sdfcage::Status::Failed:
-    default:
-      return "Failed";
-  }
-}
-
-template <typename ArrayT, typename ValueT>
-void AddFieldValue(vtkFieldData* fd, const char* name, ValueT value)
-{
-  vtkNew<ArrayT> array;
-  array->SetName(name);
-  array->SetNumberOfTuples(1);
-  array->SetValue(0, value);
-  fd->AddArray(array);
-}
 } // namespace
+
+using namespace sdfcage_vtk;
 
 //------------------------------------------------------------------------------
 vtkSDFCageFilter::vtkSDFCageFilter()
@@ -286,6 +77,13 @@ vtkSDFCageFilter::vtkSDFCageFilter()
   this->MaximumRefinements = defaults.MaximumRefinements;
   this->GenerateDistanceField = defaults.KeepDistanceField ? 1 : 0;
   this->NumberOfThreads = defaults.NumberOfThreads;
+  this->Optimize = cageDefaults.Optimize ? 1 : 0;
+  this->Energy = static_cast<int>(cageDefaults.Optimization.Energy);
+  this->TargetSpacing = cageDefaults.Optimization.TargetSpacing;
+  this->BarrierWeight = cageDefaults.Optimization.BarrierWeight;
+  this->BarrierDistance = cageDefaults.Optimization.BarrierDistance;
+  this->NumberOfIterations = cageDefaults.Optimization.NumberOfIterations;
+  this->EdgeFlips = cageDefaults.Optimization.EdgeFlips ? 1 : 0;
 
   this->SetNumberOfInputPorts(1);
   this->SetNumberOfOutputPorts(3);
@@ -305,6 +103,9 @@ void vtkSDFCageFilter::ResetResults()
   this->SimplificationTime = 0.0;
   this->CageVerificationTime = 0.0;
   this->TotalTime = 0.0;
+  this->EnergyBefore = 0.0;
+  this->EnergyAfter = 0.0;
+  this->OptimizationTime = 0.0;
   this->VerticesReached = 0;
   this->TargetReached = false;
   this->StopReason.clear();
@@ -361,6 +162,12 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
     AddFieldValue<vtkDoubleArray>(fd, "SimplificationTime", this->SimplificationTime);
     AddFieldValue<vtkDoubleArray>(fd, "CageVerificationTime", this->CageVerificationTime);
     AddFieldValue<vtkDoubleArray>(fd, "TotalTime", this->TotalTime);
+    if (this->Optimize)
+    {
+      AddFieldValue<vtkDoubleArray>(fd, "EnergyBefore", this->EnergyBefore);
+      AddFieldValue<vtkDoubleArray>(fd, "EnergyAfter", this->EnergyAfter);
+      AddFieldValue<vtkDoubleArray>(fd, "OptimizationTime", this->OptimizationTime);
+    }
     AddFieldValue<vtkIntArray>(fd, "VerticesReached", this->VerticesReached);
     AddFieldValue<vtkIntArray>(fd, "TargetReached", this->TargetReached ? 1 : 0);
     AddFieldValue<vtkStringArray>(fd, "StopReason", this->StopReason);
@@ -415,6 +222,13 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
     options.Envelope.MaximumRefinements = this->MaximumRefinements;
     options.Envelope.KeepDistanceField = this->GenerateDistanceField != 0;
     options.Envelope.NumberOfThreads = this->NumberOfThreads;
+    options.Optimize = this->Optimize != 0;
+    options.Optimization.Energy = this->Energy == 1 ? sdfcage::CageEnergy::Spacing : sdfcage::CageEnergy::MIPS;
+    options.Optimization.TargetSpacing = this->TargetSpacing;
+    options.Optimization.BarrierWeight = this->BarrierWeight;
+    options.Optimization.BarrierDistance = this->BarrierDistance;
+    options.Optimization.NumberOfIterations = this->NumberOfIterations;
+    options.Optimization.EdgeFlips = this->EdgeFlips != 0;
 
     FilterProgress progress(this);
     this->UpdateProgress(0.0);
@@ -427,6 +241,9 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
     this->SimplificationTime = result.SimplificationSeconds;
     this->CageVerificationTime = result.CageVerificationSeconds;
     this->TotalTime = result.TotalSeconds;
+    this->EnergyBefore = result.Optimization.EnergyBefore;
+    this->EnergyAfter = result.Optimization.EnergyAfter;
+    this->OptimizationTime = result.OptimizationSeconds;
     this->VerticesReached = result.VerticesReached;
     this->TargetReached = result.TargetReached;
     this->StopReason = result.StopReason;
@@ -483,6 +300,11 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
     }
 
     std::vector<std::string> warnings = result.Defects.warnings();
+    if (this->Optimize && !result.Optimized && result.State == sdfcage::Status::Ok)
+    {
+      warnings.push_back("the cage was not optimized: " +
+        (result.Optimization.Message.empty() ? std::string("no reason given") : result.Optimization.Message));
+    }
     if (!result.TargetReached)
     {
       std::ostringstream msg;
@@ -547,6 +369,13 @@ void vtkSDFCageFilter::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "GenerateDistanceField: " << (this->GenerateDistanceField ? "On" : "Off")
      << "\n";
   os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";
+  os << indent << "Optimize: " << (this->Optimize ? "On" : "Off") << "\n";
+  os << indent << "Energy: " << (this->Energy == 1 ? "Spacing" : "MIPS") << "\n";
+  os << indent << "TargetSpacing: " << this->TargetSpacing << "\n";
+  os << indent << "BarrierWeight: " << this->BarrierWeight << "\n";
+  os << indent << "BarrierDistance: " << this->BarrierDistance << "\n";
+  os << indent << "NumberOfIterations: " << this->NumberOfIterations << "\n";
+  os << indent << "EdgeFlips: " << (this->EdgeFlips ? "On" : "Off") << "\n";
   os << indent << "Status: " << this->StatusString << "\n";
   os << indent << "LastErrorMessage: " << this->LastErrorMessage << "\n";
   os << indent << "ValidationTime: " << this->ValidationTime << "\n";
