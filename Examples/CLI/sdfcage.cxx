@@ -1,8 +1,8 @@
 // SDFCage — the command-line program: a closed mesh (or the built-in shape) -> its cage.
 //
 //   sdfcage [INPUT] [-o OUT] [-n N] [--iso C] [--voxel H] [--clearance D] [--adaptivity A]
-//           [--refinements N] [--report FILE.json] [--screenshot FILE.png] [--threads N] [--quiet]
-//           [--help] [--version]
+//           [--refinements N] [--optimize none|mips|spacing] [--spacing H] [--iterations K]
+//           [--report FILE.json] [--screenshot FILE.png] [--threads N] [--quiet] [--help] [--version]
 //
 // Exit codes: 0 cage written and enclosure verified; 1 enclosure could not be verified;
 // 2 bad command line or unusable input; 3 could not write an output, render, or other failure;
@@ -82,6 +82,10 @@ void printUsage(std::ostream& os)
         "      --adaptivity A      isosurface adaptivity in [0, 1]: 0 uniform triangles, larger\n"
         "                          merges flat regions (fewer triangles); default 0.1\n"
         "      --refinements N     times the grid may be refined if verification fails, default 2\n"
+        "      --optimize E        optimize the cage (paper 3.3): none (default), mips (well-shaped\n"
+        "                          triangles) or spacing (the cage at distance H from the input)\n"
+        "      --spacing H         target distance of --optimize spacing, default 0.05\n"
+        "      --iterations K      optimization rounds (relocation + edge flips), default 1\n"
         "      --report FILE.json  write the results as JSON\n"
         "      --screenshot FILE.png\n"
         "                          render input and cage offscreen to a PNG (needs an X server:\n"
@@ -108,6 +112,9 @@ struct Options
   double Adaptivity = -1.0; ///< -1 = the filter's default
   int Vertices = -1;        ///< -1 = the filter's default
   int Refinements = -1; ///< -1 = the filter's default
+  std::string Optimize = "none"; ///< none, mips or spacing
+  double Spacing = -1.0;         ///< -1 = the filter's default
+  int Iterations = -1;           ///< -1 = the filter's default
   int Threads = 0;
   bool Quiet = false;
   bool Help = false;
@@ -271,6 +278,24 @@ Options parseOptions(int argc, char* argv[], vtkSDFCageFilter* limits)
     {
       o.Refinements = parseInt(arg, takeValue(), limits->GetMaximumRefinementsMinValue(),
         limits->GetMaximumRefinementsMaxValue());
+    }
+    else if (arg == "--optimize")
+    {
+      o.Optimize = takeValue();
+      if (o.Optimize != "none" && o.Optimize != "mips" && o.Optimize != "spacing")
+      {
+        throw UsageError{ "--optimize expects none, mips or spacing, got '" + o.Optimize + "'" };
+      }
+    }
+    else if (arg == "--spacing")
+    {
+      o.Spacing = parseDouble(
+        arg, takeValue(), limits->GetTargetSpacingMinValue(), limits->GetTargetSpacingMaxValue());
+    }
+    else if (arg == "--iterations")
+    {
+      o.Iterations = parseInt(arg, takeValue(), limits->GetNumberOfIterationsMinValue(),
+        limits->GetNumberOfIterationsMaxValue());
     }
     else if (arg == "--threads")
     {
@@ -506,6 +531,26 @@ int run(const Options& o, MessageCollector* messages)
   {
     filter->SetMaximumRefinements(o.Refinements);
   }
+  filter->SetOptimize(o.Optimize != "none");
+  if (o.Optimize == "spacing")
+  {
+    filter->SetEnergyToSpacing();
+  }
+  else
+  {
+    filter->SetEnergyToMIPS();
+  }
+  if (o.Spacing >= 0)
+  {
+    filter->SetTargetSpacing(o.Spacing);
+  }
+  if (o.Iterations >= 0)
+  {
+    filter->SetNumberOfIterations(o.Iterations);
+  }
+  r.Optimize = o.Optimize;
+  r.TargetSpacing = filter->GetTargetSpacing();
+  r.NumberOfIterations = filter->GetNumberOfIterations();
   r.Adaptivity = filter->GetAdaptivity();
   r.TargetNumberOfVertices = filter->GetTargetNumberOfVertices();
   r.MaximumRefinements = filter->GetMaximumRefinements();
@@ -526,6 +571,9 @@ int run(const Options& o, MessageCollector* messages)
   r.VerificationTime = filter->GetVerificationTime();
   r.SimplificationTime = filter->GetSimplificationTime();
   r.CageVerificationTime = filter->GetCageVerificationTime();
+  r.OptimizationTime = filter->GetOptimizationTime();
+  r.EnergyBefore = filter->GetEnergyBefore();
+  r.EnergyAfter = filter->GetEnergyAfter();
   r.VerticesReached = filter->GetVerticesReached();
   r.TargetReached = filter->GetTargetReached();
   r.StopReason = filter->GetStopReason();
