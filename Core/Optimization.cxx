@@ -381,6 +381,24 @@ public:
         far.push_back(f);
     }
     primitives(far, T, P, SelfDelta, L.CageBarrier);
+    // pairs already closer than the self clearance keep half their distance (see relaxed())
+    Primitives& b = L.CageBarrier;
+    for (std::size_t i = 0; i < b.Tri.size(); ++i)
+      b.TriMargin[i] = relaxed((L.P0 - closestPointOnTriangle(L.P0, b.Tri[i][0], b.Tri[i][1], b.Tri[i][2])).norm());
+    for (std::size_t i = 0; i < b.Edge.size(); ++i)
+    {
+      double d = Inf, s, t;
+      for (const auto& ids : L.RingIds)
+        d = std::min(d, std::sqrt(segmentSegmentClosest(L.P0, P[ids[1]], b.Edge[i][0], b.Edge[i][1], s, t)));
+      b.EdgeMargin[i] = relaxed(d);
+    }
+    for (std::size_t i = 0; i < b.Point.size(); ++i)
+    {
+      double d = Inf;
+      for (const auto& ids : L.RingIds)
+        d = std::min(d, (b.Point[i] - closestPointOnTriangle(b.Point[i], L.P0, P[ids[1]], P[ids[2]])).norm());
+      b.PointMargin[i] = relaxed(d);
+    }
   }
 
   /// Barrier primitives of the triangles `tris` of a mesh (triangles, points): every triangle,
@@ -420,6 +438,11 @@ public:
       out.PointMargin.push_back(margin);
     }
   }
+
+  /// The distance a pair of vertex-disjoint cage triangles must keep: the self clearance, or half
+  /// their distance before the move when they were already closer (a given cage, or the dense
+  /// envelope's leftovers, may have such pairs; they may move, but never touch).
+  double relaxed(double before) const { return before >= SelfDelta ? SelfDelta : 0.5 * before; }
 
   /// Is the straight move of v from P0 to q collision-free? The ring triangle (v, a, b) sweeps
   /// exactly the tetrahedron conv(P0, q, a, b) (a point of it is (P0 + s (q - P0)) weighted with
@@ -463,12 +486,14 @@ public:
       {
         // the tetrahedron lies within `moved` of the starting triangle; also skips pairs
         // sharing a vertex (infinite bound)
-        if (L.CageD0[r * nc + i] - moved - SelfDelta >= 0)
+        const double d0 = L.CageD0[r * nc + i];
+        const double margin = relaxed(d0);
+        if (d0 - moved - margin >= 0)
           continue;
         const Triangle& t = T[L.CageTris[i]];
         const Vec3 c[3] = { P[t[0]], P[t[1]], P[t[2]] };
         for (const auto& f : faces)
-          if (triangleTriangleDistance2(f, c) < SelfDelta * SelfDelta)
+          if (triangleTriangleDistance2(f, c) < margin * margin)
             return false;
         for (const Vec3& x : c)
           if (inside(x))
@@ -613,6 +638,7 @@ public:
   /// (its tetrahedra have the ring at p as a face, tested with the same anyCloserThan).
   bool ringAcceptable(const Local& L, const Vec3& p, bool inputChecked) const
   {
+    LastVeto = Veto::Shape;
     const int n = static_cast<int>(L.RingIds.size());
     std::vector<std::array<Vec3, 3>> pts(n);
     for (int i = 0; i < n; ++i)
@@ -629,6 +655,7 @@ public:
       if (!inputChecked && Tree.anyCloserThan(pts[i].data(), Delta))
         return false;
     }
+    LastVeto = Veto::Self;
     for (int i = 0; i < n; ++i)
       for (int j = i + 1; j < n; ++j)
         if (trianglesConflict(L.RingIds[i].data(), pts[i].data(), L.RingIds[j].data(), pts[j].data(), SelfDelta, FoldCosine))
@@ -637,15 +664,18 @@ public:
     {
       const Vec3 lo = pts[i][0].cwiseMin(pts[i][1]).cwiseMin(pts[i][2]) - Vec3::Constant(SelfDelta);
       const Vec3 hi = pts[i][0].cwiseMax(pts[i][1]).cwiseMax(pts[i][2]) + Vec3::Constant(SelfDelta);
-      if (!othersClear(L.RingIds[i].data(), pts[i].data(), lo, hi, L.Ring.data(), L.Ring.size()))
+      const Vec3 before[3] = { L.P0, P[L.RingIds[i][1]], P[L.RingIds[i][2]] };
+      if (!othersClear(L.RingIds[i].data(), pts[i].data(), lo, hi, L.Ring.data(), L.Ring.size(), before))
         return false;
     }
     return true;
   }
 
   /// No cage triangle other than `skip` conflicts with the triangle (ids, pts) of box [lo, hi].
+  /// `before` (optional): the same triangle before the change, for the relaxed margin of pairs
+  /// that were already closer than the self clearance.
   bool othersClear(const int ids[3], const Vec3 pts[3], const Vec3& lo, const Vec3& hi, const int* skip,
-    std::size_t skipCount) const
+    std::size_t skipCount, const Vec3* before = nullptr) const
   {
     for (std::size_t f = 0; f < T.size(); ++f)
     {
@@ -667,7 +697,14 @@ public:
           continue;
       }
       if (trianglesConflict(ids, pts, tid, tp, SelfDelta, FoldCosine))
-        return false;
+      {
+        if (!disjoint || !before)
+          return false;
+        const double d0 = std::sqrt(triangleTriangleDistance2(before, tp));
+        const double d2 = triangleTriangleDistance2(pts, tp);
+        if (d0 >= SelfDelta || d2 == 0.0 || d2 < relaxed(d0) * relaxed(d0))
+          return false;
+      }
     }
     return true;
   }
@@ -690,31 +727,57 @@ public:
       return std::isfinite(e0) ? 0 : -1;
     const Vec3 dir = -g / gn;
     double step = reach;
+    Veto worst = Veto::Energy; // the last reason a trial step failed
     for (int k = 0; k < LineSearchTries; ++k, step *= 0.5)
     {
       // energy first (cheaper than the collision test), then the collision-free fraction
       const Vec3 move = step * dir;
       Vec3 p = L.P0 + move;
       if (!(vertexEnergy(L, p, nullptr) < e0))
+      {
+        worst = Veto::Energy;
         continue;
+      }
       const double t = advance(L, move);
       if (!(t > 0))
+      {
+        ++Counts[static_cast<int>(Veto::Collision)];
         return -1;
+      }
       if (t < 1.0)
       {
         p = L.P0 + t * move;
         if (!(vertexEnergy(L, p, nullptr) < e0))
+        {
+          worst = Veto::Collision;
           continue;
+        }
       }
       if (!ringAcceptable(L, p, true))
+      {
+        worst = LastVeto;
         continue;
+      }
       P[v] = p;
       for (int f : L.Ring)
         updateBox(f);
       return 1;
     }
+    ++Counts[static_cast<int>(worst)];
     return -1;
   }
+
+  /// Why descent steps failed (the reason of their last trial): energy not lowered, collision
+  /// (CCD), shape (flip or needle), self-intersection (static test).
+  enum class Veto
+  {
+    Energy = 0,
+    Collision,
+    Shape,
+    Self
+  };
+  long long Counts[4] = { 0, 0, 0, 0 };
+  mutable Veto LastVeto = Veto::Shape;
 
   // ---- edge flip of (a, b): 1 flipped, 0 not worth it / not allowed topologically, -1 vetoed
   int tryFlip(int a, int b)
@@ -900,6 +963,12 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
 
   Optimizer opt(cage, input, inputTree, options, delta, selfDelta, progress);
   bool cancelled = false;
+  const auto copyCounts = [&]() {
+    r.MovesWithoutDescent = opt.Counts[0];
+    r.MovesCutByCollision = opt.Counts[1];
+    r.MovesVetoedByShape = opt.Counts[2];
+    r.MovesVetoedBySelfIntersection = opt.Counts[3];
+  };
   const int rounds = std::max(0, options.NumberOfIterations);
   for (int it = 0; it < rounds && !cancelled; ++it)
   {
@@ -916,6 +985,7 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
     }
   }
 
+  copyCounts();
   // independent verification of the result (also after a cancel: the partial result is valid)
   progressStage(progress, "verifying the optimized cage", 0.9, 1.0);
   const auto t2 = std::chrono::steady_clock::now();

@@ -72,7 +72,11 @@ struct OptimizeResult
   double MinimumAngleBefore = 0.0;  ///< degrees
   double MinimumAngleAfter = 0.0;   ///< degrees
   long long Moves = 0;              ///< accepted descent steps
-  long long RejectedMoves = 0;      ///< descent steps with no acceptable step size
+  long long RejectedMoves = 0;      ///< descent steps with no acceptable step size, by the reason
+  long long MovesWithoutDescent = 0; ///< ... of their last trial: the energy did not drop,
+  long long MovesCutByCollision = 0; ///< the CCD allowed nothing (or too little to lower it),
+  long long MovesVetoedByShape = 0;  ///< a ring triangle would flip or become a needle,
+  long long MovesVetoedBySelfIntersection = 0; ///< the static self-intersection test failed
   long long Flips = 0;
   long long RejectedFlips = 0;      ///< flips that would lower the energy but break a constraint
   bool Reverted = false;            ///< the final verification failed: the given cage is returned
