@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -29,6 +30,8 @@ constexpr double Inf = std::numeric_limits<double>::infinity();
 constexpr double FoldCosine = -0.95;
 // Bisection steps of the continuous collision detection when a whole move is not clear.
 constexpr int BisectionSteps = 10;
+// Sufficient-decrease fraction of the line search (Armijo condition).
+constexpr double ArmijoFraction = 0.1;
 // Backtracking halvings of the line search.
 constexpr int LineSearchTries = 8;
 // The first trial step of the line search, relative to the mean edge length around the vertex.
@@ -733,7 +736,9 @@ public:
       // energy first (cheaper than the collision test), then the collision-free fraction
       const Vec3 move = step * dir;
       Vec3 p = L.P0 + move;
-      if (!(vertexEnergy(L, p, nullptr) < e0))
+      // sufficient decrease (Armijo): at least a fraction of what the slope promises
+      const double wanted = e0 - ArmijoFraction * step * gn;
+      if (!(vertexEnergy(L, p, nullptr) <= wanted))
       {
         worst = Veto::Energy;
         continue;
@@ -747,7 +752,7 @@ public:
       if (t < 1.0)
       {
         p = L.P0 + t * move;
-        if (!(vertexEnergy(L, p, nullptr) < e0))
+        if (!(vertexEnergy(L, p, nullptr) <= e0 - ArmijoFraction * t * step * gn))
         {
           worst = Veto::Collision;
           continue;
@@ -970,6 +975,7 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
     r.MovesVetoedBySelfIntersection = opt.Counts[3];
   };
   const int rounds = std::max(0, options.NumberOfIterations);
+  const std::clock_t cpu0 = std::clock();
   for (int it = 0; it < rounds && !cancelled; ++it)
   {
     progressStage(progress, "relocating cage vertices", 0.05 + 0.85 * it / rounds, 0.05 + 0.85 * (it + 0.8) / rounds);
@@ -985,6 +991,7 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
     }
   }
 
+  r.RelocationAndFlipCpuSeconds = double(std::clock() - cpu0) / CLOCKS_PER_SEC;
   copyCounts();
   // independent verification of the result (also after a cancel: the partial result is valid)
   progressStage(progress, "verifying the optimized cage", 0.9, 1.0);

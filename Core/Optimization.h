@@ -83,6 +83,7 @@ struct OptimizeResult
   double Seconds = 0.0;
   double RelocationSeconds = 0.0;
   double FlipSeconds = 0.0;
+  double RelocationAndFlipCpuSeconds = 0.0; ///< processor time of the passes (they are sequential)
   double VerificationSeconds = 0.0;
 };
 
