@@ -108,6 +108,8 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
     result.CageDistanceToInput = result.EnvelopeDistanceToInput;
     result.VerticesReached = static_cast<int>(result.Cage.Points.size());
     result.TargetReached = true;
+    if (options.Optimize)
+      result.Optimization.Message = "the optimization needs a simplified cage (a target number of vertices > 0)";
   }
   else
   {

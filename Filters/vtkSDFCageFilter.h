@@ -20,6 +20,8 @@
  * Simplification stage (§3.2): constrained quadric-error edge collapses reduce the envelope to
  * TargetNumberOfVertices vertices; every collapse keeps the clearance, avoids self-intersections and
  * keeps the surface manifold, and the final cage is verified again independently.
+ * Optional optimization stage (§3.3, Optimize off by default): vertex relocation and edge flips
+ * lower a MIPS or cage-spacing energy while every guarantee is kept (see vtkCageOptimizeFilter).
  *
  * The input must be a closed (watertight), manifold, consistently oriented surface: polygons and
  * triangle strips are triangulated, vertex and line cells are ignored, an inward-oriented mesh is
@@ -59,7 +61,7 @@
  *
  * @sa
  * vtkFillHolesFilter vtkTriangleFilter vtkCleanPolyData vtkQuadricDecimation vtkOFFReader
- * vtkOFFWriter
+ * vtkOFFWriter vtkCageOptimizeFilter
  */
 
 #ifndef vtkSDFCageFilter_h
