@@ -6,6 +6,10 @@
 #include "TriangleTree.h"
 #include "Validation.h"
 
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <chrono>
 #include <ctime>
@@ -32,6 +36,8 @@ constexpr double FoldCosine = -0.95;
 constexpr int BisectionSteps = 10;
 // Sufficient-decrease fraction of the line search (Armijo condition).
 constexpr double ArmijoFraction = 0.1;
+// Vertices relocated together at most (a batch of non-overlapping regions).
+constexpr std::size_t MaximumBatch = 256;
 // Backtracking halvings of the line search.
 constexpr int LineSearchTries = 8;
 // The first trial step of the line search, relative to the mean edge length around the vertex.
@@ -189,27 +195,92 @@ public:
   }
 
   /// One relocation pass over every vertex. Returns false when cancelled.
+  ///
+  /// Vertices are relocated in batches whose regions do not overlap, the batches in parallel. The
+  /// region of a vertex is the box of its one-ring grown by everything its descent steps can touch
+  /// or read: its whole motion (DescentSteps trial steps of at most `reach`), the radius within
+  /// which cage triangles are gathered, and the self clearance. A vertex of a batch therefore
+  /// never reads a position another vertex of the batch writes (cage triangle boxes are updated
+  /// between batches), so a batch gives the same result in any order and on any number of threads.
+  /// Batches take the pending vertices in index order, deferring those that overlap.
   bool relocationPass(OptimizeResult& r, double progressBegin, double progressEnd)
   {
+    const int steps = std::max(1, Opt.DescentSteps);
+    const double dh = std::max(0.0, Opt.BarrierDistance);
+    std::vector<int> pending, next, batch;
     for (std::size_t v = 0; v < P.size(); ++v)
+      if (!VT[v].empty())
+        pending.push_back(static_cast<int>(v));
+    const std::size_t total = pending.size();
+    std::vector<double> reach(P.size(), 0.0);
+    std::vector<Vec3> boxLo, boxHi;
+    std::vector<int> outcomeMoves, outcomeRejected;
+    std::size_t done = 0;
+    while (!pending.empty())
     {
-      if (v % 32 == 0 && Prog &&
-        Prog->update(progressBegin + (progressEnd - progressBegin) * double(v) / double(P.size())))
+      if (Prog && Prog->update(progressBegin + (progressEnd - progressBegin) * double(done) / double(std::max<std::size_t>(1, total))))
         return false;
-      if (VT[v].empty())
-        continue;
-      for (int step = 0; step < std::max(1, Opt.DescentSteps); ++step)
+      batch.clear();
+      next.clear();
+      boxLo.clear();
+      boxHi.clear();
+      for (int v : pending)
       {
-        const int outcome = descend(static_cast<int>(v));
-        if (outcome > 0)
-          ++r.Moves;
-        else
+        Vec3 lo = Vec3::Constant(Inf), hi = -lo;
+        double edgeSum = 0.0;
+        for (int f : VT[v])
+          for (int w : T[f])
+          {
+            lo = lo.cwiseMin(P[w]);
+            hi = hi.cwiseMax(P[w]);
+            edgeSum += (P[w] - P[v]).norm(); // each neighbour twice, v itself adds 0
+          }
+        reach[v] = InitialStep * edgeSum / (2.0 * double(VT[v].size()));
+        const double grow = steps * reach[v] + SelfDelta + dh + reach[v] + SelfDelta;
+        lo -= Vec3::Constant(grow);
+        hi += Vec3::Constant(grow);
+        bool overlaps = batch.size() >= MaximumBatch;
+        for (std::size_t i = 0; i < batch.size() && !overlaps; ++i)
+          overlaps = !((boxLo[i].array() > hi.array()).any() || (boxHi[i].array() < lo.array()).any());
+        if (overlaps)
         {
-          if (outcome < 0)
-            ++r.RejectedMoves;
-          break;
+          next.push_back(v);
+          continue;
         }
+        batch.push_back(v);
+        boxLo.push_back(lo);
+        boxHi.push_back(hi);
       }
+      outcomeMoves.assign(batch.size(), 0);
+      outcomeRejected.assign(batch.size(), 0);
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, batch.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t i = range.begin(); i != range.end(); ++i)
+        {
+          const int v = batch[i];
+          for (int step = 0; step < steps; ++step)
+          {
+            const int outcome = descend(v, reach[v]);
+            if (outcome > 0)
+              ++outcomeMoves[i];
+            else
+            {
+              if (outcome < 0)
+                ++outcomeRejected[i];
+              break;
+            }
+          }
+        }
+      });
+      for (std::size_t i = 0; i < batch.size(); ++i)
+      {
+        r.Moves += outcomeMoves[i];
+        r.RejectedMoves += outcomeRejected[i];
+        if (outcomeMoves[i] > 0)
+          for (int f : VT[batch[i]])
+            updateBox(f);
+      }
+      done += batch.size();
+      pending.swap(next);
     }
     return true;
   }
@@ -410,8 +481,9 @@ public:
     const std::vector<Vec3>& points, double margin, Primitives& out) const
   {
     out.clear();
-    std::vector<std::uint64_t>& edges = EdgeScratch;
-    std::vector<int>& ids = PointScratch;
+    Work& w = work();
+    std::vector<std::uint64_t>& edges = w.Edges;
+    std::vector<int>& ids = w.Points;
     edges.clear();
     ids.clear();
     for (int f : tris)
@@ -609,6 +681,8 @@ public:
       Vec3 gb = Vec3::Zero();
       barrierTerms(L, L.CageBarrier, p, dh, grad != nullptr, B, gb);
       // the input: only triangles within δ + d̂ of the ring at p can give a non-zero term
+      Work& w = work();
+      std::vector<int>& InputScratch = w.InputIds;
       InputScratch.clear();
       const double moved = (p - L.P0).norm();
       for (std::size_t r = 0; r < L.RingIds.size(); ++r)
@@ -622,8 +696,8 @@ public:
       {
         std::sort(InputScratch.begin(), InputScratch.end());
         InputScratch.erase(std::unique(InputScratch.begin(), InputScratch.end()), InputScratch.end());
-        primitives(InputScratch, Input.Triangles, Input.Points, Delta, InputBarrier);
-        barrierTerms(L, InputBarrier, p, dh, grad != nullptr, B, gb);
+        primitives(InputScratch, Input.Triangles, Input.Points, Delta, w.InputBarrier);
+        barrierTerms(L, w.InputBarrier, p, dh, grad != nullptr, B, gb);
       }
       e += lambda * B;
       g += lambda * gb;
@@ -641,7 +715,8 @@ public:
   /// (its tetrahedra have the ring at p as a face, tested with the same anyCloserThan).
   bool ringAcceptable(const Local& L, const Vec3& p, bool inputChecked) const
   {
-    LastVeto = Veto::Shape;
+    Work& w = work();
+    w.LastVeto = Veto::Shape;
     const int n = static_cast<int>(L.RingIds.size());
     std::vector<std::array<Vec3, 3>> pts(n);
     for (int i = 0; i < n; ++i)
@@ -658,7 +733,7 @@ public:
       if (!inputChecked && Tree.anyCloserThan(pts[i].data(), Delta))
         return false;
     }
-    LastVeto = Veto::Self;
+    w.LastVeto = Veto::Self;
     for (int i = 0; i < n; ++i)
       for (int j = i + 1; j < n; ++j)
         if (trianglesConflict(L.RingIds[i].data(), pts[i].data(), L.RingIds[j].data(), pts[j].data(), SelfDelta, FoldCosine))
@@ -713,15 +788,12 @@ public:
   }
 
   // ---- one descent step at v: 1 moved, 0 converged (no descent direction), -1 no acceptable step
-  int descend(int v)
+  /// `reach`: the first trial step (the later ones are shorter, so gathering within it covers
+  /// them all). The caller updates the boxes of the ring's triangles after a move.
+  int descend(int v, double reach)
   {
-    Local& L = Scratch;
-    // the trial steps never exceed the first one, so gathering within it covers them all
-    double edgeSum = 0.0;
-    for (int f : VT[v])
-      for (int w : T[f])
-        edgeSum += (P[w] - P[v]).norm(); // each neighbour twice, v itself adds 0
-    const double reach = InitialStep * edgeSum / (2.0 * std::max<std::size_t>(1, VT[v].size()));
+    Work& w = work();
+    Local& L = w.L;
     gather(v, reach, L);
     Vec3 g;
     const double e0 = vertexEnergy(L, L.P0, &g);
@@ -746,7 +818,7 @@ public:
       const double t = advance(L, move);
       if (!(t > 0))
       {
-        ++Counts[static_cast<int>(Veto::Collision)];
+        ++w.Counts[static_cast<int>(Veto::Collision)];
         return -1;
       }
       if (t < 1.0)
@@ -760,15 +832,13 @@ public:
       }
       if (!ringAcceptable(L, p, true))
       {
-        worst = LastVeto;
+        worst = w.LastVeto;
         continue;
       }
       P[v] = p;
-      for (int f : L.Ring)
-        updateBox(f);
       return 1;
     }
-    ++Counts[static_cast<int>(worst)];
+    ++w.Counts[static_cast<int>(worst)];
     return -1;
   }
 
@@ -781,8 +851,27 @@ public:
     Shape,
     Self
   };
-  long long Counts[4] = { 0, 0, 0, 0 };
-  mutable Veto LastVeto = Veto::Shape;
+  /// Per-thread scratch of the relocation (the const queries write only here).
+  struct Work
+  {
+    Local L;
+    std::vector<int> InputIds;
+    Primitives InputBarrier;
+    std::vector<std::uint64_t> Edges;
+    std::vector<int> Points;
+    Veto LastVeto = Veto::Shape;
+    long long Counts[4] = { 0, 0, 0, 0 };
+  };
+  Work& work() const { return Works.local(); }
+  /// The veto counts summed over the threads.
+  void counts(long long out[4]) const
+  {
+    for (int k = 0; k < 4; ++k)
+      out[k] = 0;
+    for (const Work& w : Works)
+      for (int k = 0; k < 4; ++k)
+        out[k] += w.Counts[k];
+  }
 
   // ---- edge flip of (a, b): 1 flipped, 0 not worth it / not allowed topologically, -1 vetoed
   int tryFlip(int a, int b)
@@ -876,12 +965,7 @@ private:
   std::vector<std::vector<int>> VT;
   std::vector<Vec3> Lo, Hi;
   std::vector<Vec3> Representatives; ///< one input point per input component
-  Local Scratch;
-  // scratch buffers of the const queries (the optimizer is used by one thread)
-  mutable std::vector<int> InputScratch;
-  mutable Primitives InputBarrier;
-  mutable std::vector<std::uint64_t> EdgeScratch;
-  mutable std::vector<int> PointScratch;
+  mutable tbb::enumerable_thread_specific<Work> Works;
 };
 
 } // namespace
@@ -969,10 +1053,12 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
   Optimizer opt(cage, input, inputTree, options, delta, selfDelta, progress);
   bool cancelled = false;
   const auto copyCounts = [&]() {
-    r.MovesWithoutDescent = opt.Counts[0];
-    r.MovesCutByCollision = opt.Counts[1];
-    r.MovesVetoedByShape = opt.Counts[2];
-    r.MovesVetoedBySelfIntersection = opt.Counts[3];
+    long long c[4];
+    opt.counts(c);
+    r.MovesWithoutDescent = c[0];
+    r.MovesCutByCollision = c[1];
+    r.MovesVetoedByShape = c[2];
+    r.MovesVetoedBySelfIntersection = c[3];
   };
   const int rounds = std::max(0, options.NumberOfIterations);
   const std::clock_t cpu0 = std::clock();

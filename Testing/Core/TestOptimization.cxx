@@ -278,3 +278,30 @@ TEST(Optimization, TreeTriangleQueriesMatchBruteForce)
   }
   EXPECT_GT(within, 30) << "the random queries must exercise non-empty answers";
 }
+
+TEST(Optimization, DeterministicAcrossThreadCounts)
+{
+  // the relocation runs batches of non-overlapping vertex regions in parallel: the result must
+  // not depend on the number of threads (here through generateCage's optimization step)
+  const TriangleMesh input = makeTorus(Vec3(0, 0, 0), 1.0, 0.3, 64, 24);
+  CageOptions a;
+  a.TargetNumberOfVertices = 300;
+  a.Optimize = true;
+  a.Optimization.Energy = CageEnergy::Spacing;
+  a.Optimization.TargetSpacing = 0.03;
+  CageOptions b = a;
+  a.Envelope.NumberOfThreads = 1;
+  b.Envelope.NumberOfThreads = 2;
+  const CageResult ra = generateCage(PolygonMesh::fromTriangles(input), a);
+  const CageResult rb = generateCage(PolygonMesh::fromTriangles(input), b);
+  ASSERT_EQ(ra.State, Status::Ok) << ra.Message;
+  ASSERT_EQ(rb.State, Status::Ok) << rb.Message;
+  ASSERT_TRUE(ra.Optimized && rb.Optimized) << ra.Optimization.Message << rb.Optimization.Message;
+  EXPECT_GT(ra.Optimization.Moves, 0);
+  EXPECT_LT(ra.Optimization.EnergyAfter, ra.Optimization.EnergyBefore);
+  ASSERT_EQ(ra.Cage.Points.size(), rb.Cage.Points.size());
+  for (std::size_t i = 0; i < ra.Cage.Points.size(); ++i)
+    EXPECT_EQ(ra.Cage.Points[i], rb.Cage.Points[i]) << i;
+  EXPECT_EQ(ra.Cage.Triangles, rb.Cage.Triangles);
+  EXPECT_EQ(ra.Optimization.EnergyAfter, rb.Optimization.EnergyAfter);
+}
