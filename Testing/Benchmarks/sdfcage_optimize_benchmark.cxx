@@ -3,7 +3,7 @@
 // with the energies, angles, moves and flips. The cage is made by generateCage first (not timed).
 //
 //   sdfcage_optimize_benchmark [--builtin] [--vertices N] [--iterations K] [--energy mips|spacing]
-//                              [--save-cage OUT.off] [--cage CAGE.off] [FILE]
+//                              [--save-cage OUT.off] [--cage CAGE.off] [--threads N] [FILE]
 // --save-cage writes the generated cage (input coordinates); --cage reuses one instead of
 // generating it (it must enclose FILE).
 #include "CageGenerator.h"
@@ -14,7 +14,10 @@
 #include "TriangleTree.h"
 #include "Validation.h"
 
+#include <tbb/global_control.h>
+
 #include <chrono>
+#include <memory>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -29,6 +32,7 @@ int main(int argc, char** argv)
   int vertices = 500;
   int iterations = 1;
   std::string saveCage, loadCage, only;
+  int threads = 0;
   for (int i = 1; i < argc; ++i)
   {
     if (!std::strcmp(argv[i], "--builtin"))
@@ -43,6 +47,8 @@ int main(int argc, char** argv)
       loadCage = argv[++i];
     else if (!std::strcmp(argv[i], "--energy") && i + 1 < argc)
       only = argv[++i];
+    else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc)
+      threads = std::atoi(argv[++i]);
     else if (argv[i][0] == '-')
     {
       std::printf("usage: sdfcage_optimize_benchmark [--builtin] [--vertices N] [--iterations K] [FILE]\n");
@@ -51,6 +57,9 @@ int main(int argc, char** argv)
     else
       path = argv[i];
   }
+  std::unique_ptr<tbb::global_control> limit;
+  if (threads > 0)
+    limit = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, threads);
   PolygonMesh polygons;
   if (builtin)
   {
