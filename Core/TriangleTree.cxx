@@ -192,7 +192,9 @@ double TriangleTree::triangleQuery(const Vec3 t[3], double limit, bool stopAtFir
       side[i] = (t[(i + 1) % 3] - t[i]).cross(normal);
       const double len = side[i].norm();
       side[i] = len > 0 ? Vec3(side[i] / len) : Vec3(Vec3::Zero());
-      sideOffset[i] = side[i].dot(t[i]);
+      // the offset includes the query's own corners, so the triangle is on the inner side even
+      // when its rounded normal is slightly off (slivers)
+      sideOffset[i] = std::max({ side[i].dot(t[0]), side[i].dot(t[1]), side[i].dot(t[2]) });
     }
   }
   auto planeGap = [&](const Vec3& lo, const Vec3& hi) {
