@@ -6,6 +6,7 @@
 #include "Geometry.h"
 #include "Normalization.h"
 #include "Optimization.h"
+#include "Progress.h"
 #include "Shapes.h"
 #include "TriangleTree.h"
 
@@ -304,4 +305,32 @@ TEST(Optimization, DeterministicAcrossThreadCounts)
     EXPECT_EQ(ra.Cage.Points[i], rb.Cage.Points[i]) << i;
   EXPECT_EQ(ra.Cage.Triangles, rb.Cage.Triangles);
   EXPECT_EQ(ra.Optimization.EnergyAfter, rb.Optimization.EnergyAfter);
+}
+
+TEST(Optimization, CancelGivesAValidPartialCage)
+{
+  class CancelDuringRelocation : public Progress
+  {
+  protected:
+    void report(double overall, const std::string& stage) override
+    {
+      if (stage == "relocating cage vertices" && overall > 0.2)
+        this->cancel();
+    }
+  };
+  const TriangleMesh input = makeSphere(Vec3(0, 0, 0), 1.0, 48, 24);
+  const TriangleMesh cage = makeSphere(Vec3(0, 0, 0), 1.1, 24, 12);
+  OptimizeOptions o;
+  o.NumberOfIterations = 5;
+  CancelDuringRelocation progress;
+  const TriangleTree tree(input);
+  const OptimizeResult r = optimizeCage(cage, input, tree, o, &progress);
+  EXPECT_EQ(r.State, Status::Cancelled) << r.Message;
+  EXPECT_FALSE(r.Reverted);
+  EXPECT_EQ(r.Cage.Points.size(), cage.Points.size());
+  // the partial result was verified like a finished one
+  const exact::ExactReport e = exact::exactCheck(input, r.Cage, 0.01);
+  EXPECT_TRUE(e.Encloses);
+  EXPECT_GE(e.MinimumClearance, r.ClearanceUsed * (1 - 1e-9));
+  EXPECT_LE(r.EnergyAfter, r.EnergyBefore);
 }
