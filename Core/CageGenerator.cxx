@@ -125,7 +125,7 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
     result.StopReason = result.Simplification.StopReason;
     // independent re-verification of the final cage (exact distances, winding numbers). It runs
     // even after a cancel: the partial cage is valid and usable.
-    progressStage(progress, "verifying cage", 0.95, 1.0);
+    progressStage(progress, "verifying cage", 0.95, options.Optimize ? 0.96 : 1.0);
     const auto t1 = std::chrono::steady_clock::now();
     std::vector<double> dist;
     std::string why;
@@ -146,9 +146,10 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
     {
       OptimizeOptions oo = options.Optimization;
       oo.Clearance = so.Clearance;
-      result.Optimization = optimizeCage(result.Simplification.Cage, unit, tree, oo, nullptr);
+      result.Optimization = optimizeCage(result.Simplification.Cage, unit, tree, oo, progress, 0.96, 1.0);
       result.OptimizationSeconds = result.Optimization.Seconds;
-      if (result.Optimization.State == Status::Ok && !result.Optimization.Reverted)
+      const Status os = result.Optimization.State;
+      if ((os == Status::Ok || os == Status::Cancelled) && !result.Optimization.Reverted)
       {
         result.Optimized = true;
         result.Simplification.Cage = std::move(result.Optimization.Cage);
@@ -165,10 +166,11 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
     result.MinimumClearanceRelative = clearance;
     result.MinimumClearance = n.lengthToInput(clearance);
     result.Simplification.Cage = TriangleMesh(); // the result keeps the input-unit copy only
-    if (result.Simplification.Cancelled)
+    if (result.Simplification.Cancelled || result.Optimization.State == Status::Cancelled)
     {
       result.State = Status::Cancelled;
-      result.Message = "cancelled during simplification; the cage so far is valid";
+      result.Message = result.Simplification.Cancelled ? "cancelled during simplification; the cage so far is valid"
+                                                        : "cancelled during optimization; the cage so far is valid";
       result.TotalSeconds = seconds(start);
       return result;
     }

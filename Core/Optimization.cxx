@@ -1005,8 +1005,13 @@ double collisionFreeFraction(const TriangleMesh& cage, int v, const Vec3& move, 
 }
 
 OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input, const TriangleTree& inputTree,
-  const OptimizeOptions& options, Progress* progress)
+  const OptimizeOptions& options, Progress* progress, double progressBegin, double progressEnd)
 {
+  // stages over [progressBegin, progressEnd] of the whole run
+  const auto stage = [&](const char* name, double b, double e) {
+    progressStage(progress, name, progressBegin + (progressEnd - progressBegin) * b,
+      progressBegin + (progressEnd - progressBegin) * e);
+  };
   OptimizeResult r;
   const auto start = std::chrono::steady_clock::now();
   r.Cage = cage;
@@ -1024,7 +1029,7 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
     return r;
   }
   // the given cage must already satisfy the guarantees; measure its clearance
-  progressStage(progress, "verifying the given cage", 0.0, 0.05);
+  stage("verifying the given cage", 0.0, 0.05);
   std::string why;
   double measured = 0.0;
   const auto tv = std::chrono::steady_clock::now();
@@ -1064,13 +1069,13 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
   const std::clock_t cpu0 = std::clock();
   for (int it = 0; it < rounds && !cancelled; ++it)
   {
-    progressStage(progress, "relocating cage vertices", 0.05 + 0.85 * it / rounds, 0.05 + 0.85 * (it + 0.8) / rounds);
+    stage("relocating cage vertices", 0.05 + 0.85 * it / rounds, 0.05 + 0.85 * (it + 0.8) / rounds);
     const auto t0 = std::chrono::steady_clock::now();
     cancelled = !opt.relocationPass(r, 0.0, 1.0);
     r.RelocationSeconds += seconds(t0);
     if (!cancelled && options.EdgeFlips)
     {
-      progressStage(progress, "flipping cage edges", 0.05 + 0.85 * (it + 0.8) / rounds, 0.05 + 0.85 * (it + 1.0) / rounds);
+      stage("flipping cage edges", 0.05 + 0.85 * (it + 0.8) / rounds, 0.05 + 0.85 * (it + 1.0) / rounds);
       const auto t1 = std::chrono::steady_clock::now();
       cancelled = !opt.flipPass(r);
       r.FlipSeconds += seconds(t1);
@@ -1080,7 +1085,7 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
   r.RelocationAndFlipCpuSeconds = double(std::clock() - cpu0) / CLOCKS_PER_SEC;
   copyCounts();
   // independent verification of the result (also after a cancel: the partial result is valid)
-  progressStage(progress, "verifying the optimized cage", 0.9, 1.0);
+  stage("verifying the optimized cage", 0.9, 1.0);
   const auto t2 = std::chrono::steady_clock::now();
   TriangleMesh result = opt.mesh();
   double clearance = 0.0;

@@ -90,9 +90,12 @@ struct OptimizeResult
 /// Optimizes `cage` (closed, outward, enclosing `input` with clearance) in unit-sphere units.
 /// `inputTree` indexes `input`. Sequential and deterministic. The given cage is verified first
 /// (InvalidInput if it fails); the result is verified with verifyEnclosure and, should that ever
-/// fail, the given cage is returned unchanged with Reverted and a message.
+/// fail, the given cage is returned unchanged with Reverted and a message. Progress stages cover
+/// [progressBegin, progressEnd] of the whole run; a cancel returns the (verified) cage so far with
+/// State Cancelled.
 OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input, const TriangleTree& inputTree,
-  const OptimizeOptions& options, Progress* progress = nullptr);
+  const OptimizeOptions& options, Progress* progress = nullptr, double progressBegin = 0.0,
+  double progressEnd = 1.0);
 
 /// The same for meshes in the input's own coordinates: normalizes both by the input (as
 /// generateCage does), optimizes, and maps the cage, DistanceToInput and MinimumClearance back to

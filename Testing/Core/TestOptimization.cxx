@@ -334,3 +334,36 @@ TEST(Optimization, CancelGivesAValidPartialCage)
   EXPECT_GE(e.MinimumClearance, r.ClearanceUsed * (1 - 1e-9));
   EXPECT_LE(r.EnergyAfter, r.EnergyBefore);
 }
+
+TEST(Optimization, CancelInsideGenerateCage)
+{
+  // generateCage's optimization step reports progress and honours a cancel: the cage so far is
+  // verified and output with Cancelled
+  class CancelDuringOptimization : public Progress
+  {
+  protected:
+    void report(double, const std::string& stage) override
+    {
+      Stages.push_back(stage);
+      if (stage == "relocating cage vertices")
+        this->cancel();
+    }
+
+  public:
+    std::vector<std::string> Stages;
+  };
+  const TriangleMesh input = makeTorus(Vec3(0, 0, 0), 1.0, 0.3, 64, 24);
+  CageOptions o;
+  o.TargetNumberOfVertices = 300;
+  o.Optimize = true;
+  o.Optimization.NumberOfIterations = 3;
+  CancelDuringOptimization progress;
+  const CageResult r = generateCage(PolygonMesh::fromTriangles(input), o, &progress);
+  EXPECT_EQ(r.State, Status::Cancelled) << r.Message;
+  EXPECT_NE(r.Message.find("optimization"), std::string::npos) << r.Message;
+  EXPECT_NE(std::find(progress.Stages.begin(), progress.Stages.end(), "relocating cage vertices"), progress.Stages.end());
+  ASSERT_EQ(r.Cage.Points.size(), 300u);
+  const exact::ExactReport e = exact::exactCheck(input, r.Cage, r.Normalize.lengthToInput(0.01));
+  EXPECT_TRUE(e.Encloses);
+  EXPECT_GE(e.MinimumClearance, r.Normalize.lengthToInput(0.0025) * (1 - 1e-9));
+}
