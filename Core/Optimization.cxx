@@ -280,6 +280,7 @@ public:
             updateBox(f);
       }
       done += batch.size();
+      ++r.Batches;
       pending.swap(next);
     }
     return true;

@@ -77,6 +77,7 @@ struct OptimizeResult
   long long MovesCutByCollision = 0; ///< the CCD allowed nothing (or too little to lower it),
   long long MovesVetoedByShape = 0;  ///< a ring triangle would flip or become a needle,
   long long MovesVetoedBySelfIntersection = 0; ///< the static self-intersection test failed
+  long long Batches = 0;            ///< relocation batches (vertices relocated in parallel)
   long long Flips = 0;
   long long RejectedFlips = 0;      ///< flips that would lower the energy but break a constraint
   bool Reverted = false;            ///< the final verification failed: the given cage is returned

@@ -139,6 +139,8 @@ int main(int argc, char** argv)
       r.RelocationAndFlipCpuSeconds,
       r.VerificationSeconds, r.Seconds, r.EnergyBefore, r.EnergyAfter, r.MinimumAngleBefore, r.MinimumAngleAfter,
       r.Moves, r.Flips);
+    std::printf("%-8s   %lld relocation batches (mean %.1f vertices each)\n", "", r.Batches,
+      double(unitCage.Points.size() * std::max(1, iterations)) / double(std::max(1LL, r.Batches)));
   }
   return status;
 }
