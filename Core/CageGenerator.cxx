@@ -120,6 +120,8 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
     result.CageDistanceToInput = result.EnvelopeDistanceToInput;
     result.VerticesReached = static_cast<int>(result.Cage.Points.size());
     result.TargetReached = true;
+    if (options.Optimize)
+      result.Optimization.Message = "the optimization needs a simplified cage (a target number of vertices > 0)";
   }
   else
   {
@@ -135,7 +137,7 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
     result.StopReason = result.Simplification.StopReason;
     // independent re-verification of the final cage (exact distances, winding numbers). It runs
     // even after a cancel: the partial cage is valid and usable.
-    progressStage(progress, "verifying cage", 0.95, 1.0);
+    progressStage(progress, "verifying cage", 0.95, options.Optimize ? 0.96 : 1.0);
     const auto t1 = std::chrono::steady_clock::now();
     std::vector<double> dist;
     std::string why;
@@ -150,6 +152,25 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
       result.TotalSeconds = seconds(start);
       return result;
     }
+    // 5. optional optimization (§3.3): it verifies its own result, and keeps the simplified cage
+    // if that ever fails
+    if (options.Optimize && !result.Simplification.Cancelled && !progressCancelled(progress))
+    {
+      OptimizeOptions oo = options.Optimization;
+      oo.Clearance = so.Clearance;
+      result.Optimization = optimizeCage(result.Simplification.Cage, unit, tree, oo, progress, 0.96, 1.0);
+      result.OptimizationSeconds = result.Optimization.Seconds;
+      const Status os = result.Optimization.State;
+      if ((os == Status::Ok || os == Status::Cancelled) && !result.Optimization.Reverted)
+      {
+        result.Optimized = true;
+        result.Simplification.Cage = std::move(result.Optimization.Cage);
+        dist = std::move(result.Optimization.DistanceToInput);
+        clearance = result.Optimization.MinimumClearance;
+      }
+      result.Optimization.Cage = TriangleMesh();
+      result.Optimization.DistanceToInput.clear();
+    }
     result.Cage = n.toInput(result.Simplification.Cage);
     result.CageDistanceToInput.resize(dist.size());
     for (std::size_t i = 0; i < dist.size(); ++i)
@@ -157,10 +178,11 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
     result.MinimumClearanceRelative = clearance;
     result.MinimumClearance = n.lengthToInput(clearance);
     result.Simplification.Cage = TriangleMesh(); // the result keeps the input-unit copy only
-    if (result.Simplification.Cancelled)
+    if (result.Simplification.Cancelled || result.Optimization.State == Status::Cancelled)
     {
       result.State = Status::Cancelled;
-      result.Message = "cancelled during simplification; the cage so far is valid";
+      result.Message = result.Simplification.Cancelled ? "cancelled during simplification; the cage so far is valid"
+                                                        : "cancelled during optimization; the cage so far is valid";
       result.TotalSeconds = seconds(start);
       return result;
     }

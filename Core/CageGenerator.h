@@ -3,6 +3,7 @@
 
 #include "Envelope.h"
 #include "Normalization.h"
+#include "Optimization.h"
 #include "Simplification.h"
 #include "Validation.h"
 
@@ -17,6 +18,10 @@ struct CageOptions
   int TargetNumberOfVertices = 500;
   /// Simplification knobs (Clearance is taken from Envelope.clearance()).
   SimplifyOptions Simplify;
+  /// Optional optimization of the simplified cage (paper §3.3); off by default. Its Clearance is
+  /// taken from Envelope.clearance(). Not applied when TargetNumberOfVertices is 0.
+  bool Optimize = false;
+  OptimizeOptions Optimization;
 };
 
 struct CageResult
@@ -53,6 +58,9 @@ struct CageResult
   SimplifyResult Simplification;    ///< statistics of the simplification
   double SimplificationSeconds = 0.0;
   double CageVerificationSeconds = 0.0;
+  OptimizeResult Optimization;      ///< statistics of the optional optimization (its Cage is cleared)
+  bool Optimized = false;           ///< the optimization ran and its result is the cage
+  double OptimizationSeconds = 0.0;
   double TotalSeconds = 0.0;
   ScalarImage DistanceField;        ///< input coordinates and units, when requested
   ScalarImage ModifiedDistanceField; ///< phi * xi, input units, when requested and active points exist

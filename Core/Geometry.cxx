@@ -69,9 +69,16 @@ Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const V
 
 double segmentSegmentDistance2(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1)
 {
+  double s, t;
+  return segmentSegmentClosest(p0, p1, q0, q1, s, t);
+}
+
+double segmentSegmentClosest(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1, double& s, double& t)
+{
   const Vec3 d1 = p1 - p0, d2 = q1 - q0, r = p0 - q0;
   const double a = d1.squaredNorm(), e = d2.squaredNorm(), f = d2.dot(r);
-  double s = 0.0, t = 0.0;
+  s = 0.0;
+  t = 0.0;
   if (a <= 0.0 && e <= 0.0)
   {
     return r.squaredNorm();

@@ -11,6 +11,8 @@ Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const V
 
 /// Squared distance between segments [p0, p1] and [q0, q1].
 double segmentSegmentDistance2(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1);
+/// The same, also giving the closest points p0 + s (p1 - p0) and q0 + t (q1 - q0), s, t in [0, 1].
+double segmentSegmentClosest(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1, double& s, double& t);
 
 /// Squared distance between two triangles (0 when they intersect).
 double triangleTriangleDistance2(const Vec3 a[3], const Vec3 b[3]);

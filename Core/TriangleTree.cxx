@@ -163,7 +163,7 @@ double TriangleTree::distance(const Vec3& p) const
   return d;
 }
 
-double TriangleTree::triangleQuery(const Vec3 t[3], double limit, bool stopAtFirst) const
+double TriangleTree::triangleQuery(const Vec3 t[3], double limit, bool stopAtFirst, std::vector<int>* within) const
 {
   if (Nodes.empty())
   {
@@ -180,6 +180,23 @@ double TriangleTree::triangleQuery(const Vec3 t[3], double limit, bool stopAtFir
     normal /= nlen;
   }
   const double offset = hasPlane ? normal.dot(t[0]) : 0.0;
+  // the three side planes of the query triangle (through an edge, containing the normal, facing
+  // out): the triangle lies on their inner side, so anything at least d beyond one of them is at
+  // least d from the triangle
+  Vec3 side[3];
+  double sideOffset[3] = { 0.0, 0.0, 0.0 };
+  if (hasPlane)
+  {
+    for (int i = 0; i < 3; ++i)
+    {
+      side[i] = (t[(i + 1) % 3] - t[i]).cross(normal);
+      const double len = side[i].norm();
+      side[i] = len > 0 ? Vec3(side[i] / len) : Vec3(Vec3::Zero());
+      // the offset includes the query's own corners, so the triangle is on the inner side even
+      // when its rounded normal is slightly off (slivers)
+      sideOffset[i] = std::max({ side[i].dot(t[0]), side[i].dot(t[1]), side[i].dot(t[2]) });
+    }
+  }
   auto planeGap = [&](const Vec3& lo, const Vec3& hi) {
     if (!hasPlane)
     {
@@ -188,7 +205,14 @@ double TriangleTree::triangleQuery(const Vec3 t[3], double limit, bool stopAtFir
     const Vec3 c = 0.5 * (lo + hi), e = 0.5 * (hi - lo);
     const double s = normal.dot(c) - offset;
     const double r = std::abs(normal.x()) * e.x() + std::abs(normal.y()) * e.y() + std::abs(normal.z()) * e.z();
-    return std::max(0.0, std::abs(s) - r);
+    double gap = std::abs(s) - r;
+    for (int i = 0; i < 3; ++i)
+    {
+      const Vec3& m = side[i];
+      const double below = m.dot(c) - std::abs(m.x()) * e.x() - std::abs(m.y()) * e.y() - std::abs(m.z()) * e.z();
+      gap = std::max(gap, below - sideOffset[i]);
+    }
+    return std::max(0.0, gap);
   };
   double best = limit;
   int stack[128];
@@ -218,8 +242,26 @@ double TriangleTree::triangleQuery(const Vec3 t[3], double limit, bool stopAtFir
         {
           continue;
         }
+        bool outside = false;
+        for (int k = 0; k < 3 && !outside; ++k)
+        {
+          outside = std::min({ side[k].dot(o.P[0]), side[k].dot(o.P[1]), side[k].dot(o.P[2]) }) - sideOffset[k] >= best;
+        }
+        if (outside)
+        {
+          continue;
+        }
       }
       const double d = std::sqrt(triangleTriangleDistance2(t, o.P));
+      if (within)
+      {
+        // collect every triangle below the limit; the limit never shrinks
+        if (d < best)
+        {
+          within->push_back(o.Id);
+        }
+        continue;
+      }
       if (d < best)
       {
         best = d;
@@ -275,6 +317,11 @@ long long TriangleTree::countWithin(const Vec3 t[3], double delta) const
     }
   }
   return count;
+}
+
+void TriangleTree::trianglesWithin(const Vec3 t[3], double radius, std::vector<int>& ids) const
+{
+  this->triangleQuery(t, radius, false, &ids);
 }
 
 } // namespace sdfcage

@@ -28,6 +28,8 @@ public:
   /// Number of mesh triangles at distance <= delta from triangle t (0 counts: intersecting or
   /// touching). Used to count intersecting pairs.
   long long countWithin(const Vec3 t[3], double delta) const;
+  /// Appends to `ids` the mesh triangles closer than `radius` to triangle t (exact distances).
+  void trianglesWithin(const Vec3 t[3], double radius, std::vector<int>& ids) const;
 
   /// Unit normal of mesh triangle `id` (zero for degenerate triangles).
   const Vec3& normal(int id) const { return Normals[id]; }
@@ -50,7 +52,7 @@ private:
     int Id;
   };
   int buildNode(int start, int count, std::vector<Vec3>& centroids, int depth);
-  double triangleQuery(const Vec3 t[3], double limit, bool stopAtFirst) const;
+  double triangleQuery(const Vec3 t[3], double limit, bool stopAtFirst, std::vector<int>* within = nullptr) const;
   std::vector<Node> Nodes;
   std::vector<Tri3> Tri;
   std::vector<Vec3> Normals;

@@ -38,8 +38,8 @@
 
 vtkStandardNewMacro(vtkSDFCageFilter);
 
-using namespace sdfcage_vtk;
 
+using namespace sdfcage_vtk;
 
 //------------------------------------------------------------------------------
 vtkSDFCageFilter::vtkSDFCageFilter()
@@ -60,6 +60,13 @@ vtkSDFCageFilter::vtkSDFCageFilter()
   this->AmplificationAlpha = defaults.ActivePoints.Alpha;
   this->AmplificationBeta = defaults.ActivePoints.Beta;
   this->NumberOfThreads = defaults.NumberOfThreads;
+  this->Optimize = cageDefaults.Optimize ? 1 : 0;
+  this->Energy = static_cast<int>(cageDefaults.Optimization.Energy);
+  this->TargetSpacing = cageDefaults.Optimization.TargetSpacing;
+  this->BarrierWeight = cageDefaults.Optimization.BarrierWeight;
+  this->BarrierDistance = cageDefaults.Optimization.BarrierDistance;
+  this->NumberOfIterations = cageDefaults.Optimization.NumberOfIterations;
+  this->EdgeFlips = cageDefaults.Optimization.EdgeFlips ? 1 : 0;
 
   this->SetNumberOfInputPorts(1);
   this->SetNumberOfOutputPorts(3);
@@ -79,6 +86,9 @@ void vtkSDFCageFilter::ResetResults()
   this->SimplificationTime = 0.0;
   this->CageVerificationTime = 0.0;
   this->TotalTime = 0.0;
+  this->EnergyBefore = 0.0;
+  this->EnergyAfter = 0.0;
+  this->OptimizationTime = 0.0;
   this->VerticesReached = 0;
   this->TargetReached = false;
   this->StopReason.clear();
@@ -138,6 +148,12 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
     AddFieldValue<vtkDoubleArray>(fd, "SimplificationTime", this->SimplificationTime);
     AddFieldValue<vtkDoubleArray>(fd, "CageVerificationTime", this->CageVerificationTime);
     AddFieldValue<vtkDoubleArray>(fd, "TotalTime", this->TotalTime);
+    if (this->Optimize)
+    {
+      AddFieldValue<vtkDoubleArray>(fd, "EnergyBefore", this->EnergyBefore);
+      AddFieldValue<vtkDoubleArray>(fd, "EnergyAfter", this->EnergyAfter);
+      AddFieldValue<vtkDoubleArray>(fd, "OptimizationTime", this->OptimizationTime);
+    }
     AddFieldValue<vtkIntArray>(fd, "VerticesReached", this->VerticesReached);
     AddFieldValue<vtkIntArray>(fd, "TargetReached", this->TargetReached ? 1 : 0);
     AddFieldValue<vtkStringArray>(fd, "StopReason", this->StopReason);
@@ -200,6 +216,13 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
     options.Envelope.ActivePoints.Alpha = this->AmplificationAlpha;
     options.Envelope.ActivePoints.Beta = this->AmplificationBeta;
     options.Envelope.NumberOfThreads = this->NumberOfThreads;
+    options.Optimize = this->Optimize != 0;
+    options.Optimization.Energy = this->Energy == 1 ? sdfcage::CageEnergy::Spacing : sdfcage::CageEnergy::MIPS;
+    options.Optimization.TargetSpacing = this->TargetSpacing;
+    options.Optimization.BarrierWeight = this->BarrierWeight;
+    options.Optimization.BarrierDistance = this->BarrierDistance;
+    options.Optimization.NumberOfIterations = this->NumberOfIterations;
+    options.Optimization.EdgeFlips = this->EdgeFlips != 0;
 
     FilterProgress progress(this);
     this->UpdateProgress(0.0);
@@ -212,6 +235,9 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
     this->SimplificationTime = result.SimplificationSeconds;
     this->CageVerificationTime = result.CageVerificationSeconds;
     this->TotalTime = result.TotalSeconds;
+    this->EnergyBefore = result.Optimization.EnergyBefore;
+    this->EnergyAfter = result.Optimization.EnergyAfter;
+    this->OptimizationTime = result.OptimizationSeconds;
     this->VerticesReached = result.VerticesReached;
     this->TargetReached = result.TargetReached;
     this->StopReason = result.StopReason;
@@ -271,6 +297,11 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
     }
 
     std::vector<std::string> warnings = result.Defects.warnings();
+    if (this->Optimize && !result.Optimized && result.State == sdfcage::Status::Ok)
+    {
+      warnings.push_back("the cage was not optimized: " +
+        (result.Optimization.Message.empty() ? std::string("no reason given") : result.Optimization.Message));
+    }
     if (!result.TargetReached)
     {
       std::ostringstream msg;
@@ -347,6 +378,13 @@ void vtkSDFCageFilter::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "GenerateDistanceField: " << (this->GenerateDistanceField ? "On" : "Off")
      << "\n";
   os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";
+  os << indent << "Optimize: " << (this->Optimize ? "On" : "Off") << "\n";
+  os << indent << "Energy: " << (this->Energy == 1 ? "Spacing" : "MIPS") << "\n";
+  os << indent << "TargetSpacing: " << this->TargetSpacing << "\n";
+  os << indent << "BarrierWeight: " << this->BarrierWeight << "\n";
+  os << indent << "BarrierDistance: " << this->BarrierDistance << "\n";
+  os << indent << "NumberOfIterations: " << this->NumberOfIterations << "\n";
+  os << indent << "EdgeFlips: " << (this->EdgeFlips ? "On" : "Off") << "\n";
   os << indent << "Status: " << this->StatusString << "\n";
   os << indent << "LastErrorMessage: " << this->LastErrorMessage << "\n";
   os << indent << "ValidationTime: " << this->ValidationTime << "\n";

@@ -20,6 +20,8 @@
  * Simplification stage (§3.2): constrained quadric-error edge collapses reduce the envelope to
  * TargetNumberOfVertices vertices; every collapse keeps the clearance, avoids self-intersections and
  * keeps the surface manifold, and the final cage is verified again independently.
+ * Optional optimization stage (§3.3, Optimize off by default): vertex relocation and edge flips
+ * lower a MIPS or cage-spacing energy while every guarantee is kept (see vtkCageOptimizeFilter).
  *
  * The input must be a closed (watertight), manifold, consistently oriented surface: polygons and
  * triangle strips are triangulated, vertex and line cells are ignored, an inward-oriented mesh is
@@ -59,7 +61,7 @@
  *
  * @sa
  * vtkFillHolesFilter vtkTriangleFilter vtkCleanPolyData vtkQuadricDecimation vtkOFFReader
- * vtkOFFWriter
+ * vtkOFFWriter vtkCageOptimizeFilter
  */
 
 #ifndef vtkSDFCageFilter_h
@@ -191,6 +193,43 @@ public:
 
   ///@{
   /**
+   * Optional last step (paper §3.3, off by default): optimize the simplified cage as
+   * vtkCageOptimizeFilter does, with the parameters below (same meaning and defaults there). The
+   * optimized cage is verified like any other; if the optimization cannot improve or verify it,
+   * the simplified cage is output with a warning.
+   */
+  vtkSetMacro(Optimize, vtkTypeBool);
+  vtkGetMacro(Optimize, vtkTypeBool);
+  vtkBooleanMacro(Optimize, vtkTypeBool);
+  vtkSetClampMacro(Energy, int, 0, 1);
+  vtkGetMacro(Energy, int);
+  void SetEnergyToMIPS() { this->SetEnergy(0); }
+  void SetEnergyToSpacing() { this->SetEnergy(1); }
+  vtkSetClampMacro(TargetSpacing, double, 0.0, 1.0);
+  vtkGetMacro(TargetSpacing, double);
+  vtkSetClampMacro(BarrierWeight, double, 0.0, 1.0e6);
+  vtkGetMacro(BarrierWeight, double);
+  vtkSetClampMacro(BarrierDistance, double, 0.0, 0.5);
+  vtkGetMacro(BarrierDistance, double);
+  vtkSetClampMacro(NumberOfIterations, int, 0, 1000);
+  vtkGetMacro(NumberOfIterations, int);
+  vtkSetMacro(EdgeFlips, vtkTypeBool);
+  vtkGetMacro(EdgeFlips, vtkTypeBool);
+  vtkBooleanMacro(EdgeFlips, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
+   * Optimization results (only valid after the filter has executed with Optimize on): E_quality
+   * before and after (see vtkCageOptimizeFilter) and the time in seconds.
+   */
+  vtkGetMacro(EnergyBefore, double);
+  vtkGetMacro(EnergyAfter, double);
+  vtkGetMacro(OptimizationTime, double);
+  ///@}
+
+  ///@{
+  /**
    * Timings of the last execution, in seconds (only valid after the filter has executed):
    * input validation, distance field, isosurface, envelope verification, simplification, final
    * cage verification, and the whole run.
@@ -272,6 +311,13 @@ protected:
   double GeodesicThreshold;
   double AmplificationAlpha;
   double AmplificationBeta;
+  vtkTypeBool Optimize;
+  int Energy;
+  double TargetSpacing;
+  double BarrierWeight;
+  double BarrierDistance;
+  int NumberOfIterations;
+  vtkTypeBool EdgeFlips;
 
   // results of the last execution
   double ValidationTime = 0.0;
@@ -281,6 +327,9 @@ protected:
   double SimplificationTime = 0.0;
   double CageVerificationTime = 0.0;
   double TotalTime = 0.0;
+  double EnergyBefore = 0.0;
+  double EnergyAfter = 0.0;
+  double OptimizationTime = 0.0;
   int VerticesReached = 0;
   bool TargetReached = false;
   std::string StopReason;

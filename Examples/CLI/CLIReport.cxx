@@ -101,6 +101,9 @@ std::string toJson(const RunReport& r)
   key("TargetNumberOfVertices") << r.TargetNumberOfVertices;
   key("Adaptivity") << jsonNumber(r.Adaptivity);
   key("MaximumRefinements") << r.MaximumRefinements;
+  key("Optimize") << jsonString(r.Optimize);
+  key("TargetSpacing") << jsonNumber(r.TargetSpacing);
+  key("NumberOfIterations") << r.NumberOfIterations;
   key("NumberOfThreads") << r.NumberOfThreads;
   key("UseActivePoints") << (r.UseActivePoints ? "true" : "false");
   key("ActiveRadius") << jsonNumber(r.ActiveRadius);
@@ -121,6 +124,9 @@ std::string toJson(const RunReport& r)
   key("VerificationTime") << jsonNumber(r.VerificationTime);
   key("SimplificationTime") << jsonNumber(r.SimplificationTime);
   key("CageVerificationTime") << jsonNumber(r.CageVerificationTime);
+  key("OptimizationTime") << jsonNumber(r.OptimizationTime);
+  key("EnergyBefore") << jsonNumber(r.EnergyBefore);
+  key("EnergyAfter") << jsonNumber(r.EnergyAfter);
   key("TotalTime") << jsonNumber(r.TotalTime);
   key("WriteTime") << jsonNumber(r.WriteTime);
   key("MeasuredClearance") << jsonNumber(r.MeasuredClearance);
@@ -215,6 +221,12 @@ void printSummary(std::ostream& os, const RunReport& r)
      << ", verification " << seconds(r.VerificationTime) << ",\n              simplification "
      << seconds(r.SimplificationTime) << ", cage verification "
      << seconds(r.CageVerificationTime) << ", total " << seconds(r.TotalTime) << "\n";
+  if (r.Optimize != "none")
+  {
+    os << "optimization: " << r.Optimize << " energy " << number(r.EnergyBefore) << " -> "
+       << number(r.EnergyAfter) << ", " << r.NumberOfIterations << " iteration(s), "
+       << seconds(r.OptimizationTime) << "\n";
+  }
   os << "clearance   : " << number(r.MeasuredClearance) << " (input units) = "
      << number(r.MeasuredClearanceRelative) << " relative, required >= "
      << number(r.MinimumClearanceUsed) << " relative\n";

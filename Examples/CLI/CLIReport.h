@@ -23,6 +23,9 @@ struct RunReport
   double Adaptivity = 0.0;
   int TargetNumberOfVertices = 0; ///< the target (0 = no simplification)
   int MaximumRefinements = 0;
+  std::string Optimize = "none"; ///< none, mips or spacing
+  double TargetSpacing = 0.0;
+  int NumberOfIterations = 0;
   int NumberOfThreads = 0;
   bool UseActivePoints = true;
   double ActiveRadius = 0.0;
@@ -47,6 +50,9 @@ struct RunReport
   double VerificationTime = 0.0;
   double SimplificationTime = 0.0;
   double CageVerificationTime = 0.0;
+  double OptimizationTime = 0.0;
+  double EnergyBefore = 0.0; ///< optimization energy of the simplified cage (with --optimize)
+  double EnergyAfter = 0.0;  ///< ... and of the optimized one
   double TotalTime = 0.0;
   double WriteTime = 0.0;
   double MeasuredClearance = 0.0;

@@ -2,8 +2,9 @@
 //
 //   sdfcage [INPUT] [-o OUT] [-n N] [--iso C] [--voxel H] [--clearance D] [--adaptivity A]
 //           [--refinements N] [--no-active-points] [--active-radius R] [--geodesic-threshold L]
-//           [--alpha A] [--beta B] [--report FILE.json] [--screenshot FILE.png] [--threads N]
-//           [--quiet] [--help] [--version]
+//           [--alpha A] [--beta B] [--optimize none|mips|spacing] [--spacing H] [--iterations K]
+//           [--report FILE.json] [--screenshot FILE.png] [--threads N] [--quiet] [--help]
+//           [--version]
 //   sdfcage --check INPUT CAGE [--report FILE.json] [--quiet]
 //
 // Exit codes: 0 cage written and enclosure verified; 1 enclosure could not be verified;
@@ -94,6 +95,10 @@ void printUsage(std::ostream& os)
         "                          ... but farther than L along the surface, default 0.15\n"
         "      --alpha A           amplification of the SDF at active points (> 1), default 3\n"
         "      --beta B            decay of the amplification, default 8\n"
+        "      --optimize E        optimize the cage (paper 3.3): none (default), mips (well-shaped\n"
+        "                          triangles) or spacing (the cage at distance H from the input)\n"
+        "      --spacing H         target distance of --optimize spacing, default 0.05\n"
+        "      --iterations K      optimization rounds (relocation + edge flips), default 1\n"
         "      --report FILE.json  write the results as JSON\n"
         "      --screenshot FILE.png\n"
         "                          render input and cage offscreen to a PNG (needs an X server:\n"
@@ -130,6 +135,9 @@ struct Options
   double GeodesicThreshold = -1.0; ///< -1 = the filter's default
   double Alpha = -1.0;             ///< -1 = the filter's default
   double Beta = -1.0;              ///< -1 = the filter's default
+  std::string Optimize = "none"; ///< none, mips or spacing
+  double Spacing = -1.0;         ///< -1 = the filter's default
+  int Iterations = -1;           ///< -1 = the filter's default
   int Threads = 0;
   bool Quiet = false;
   bool Help = false;
@@ -325,6 +333,24 @@ Options parseOptions(int argc, char* argv[], vtkSDFCageFilter* limits)
     {
       o.Beta = parseDouble(
         arg, takeValue(), limits->GetAmplificationBetaMinValue(), limits->GetAmplificationBetaMaxValue());
+    }
+    else if (arg == "--optimize")
+    {
+      o.Optimize = takeValue();
+      if (o.Optimize != "none" && o.Optimize != "mips" && o.Optimize != "spacing")
+      {
+        throw UsageError{ "--optimize expects none, mips or spacing, got '" + o.Optimize + "'" };
+      }
+    }
+    else if (arg == "--spacing")
+    {
+      o.Spacing = parseDouble(
+        arg, takeValue(), limits->GetTargetSpacingMinValue(), limits->GetTargetSpacingMaxValue());
+    }
+    else if (arg == "--iterations")
+    {
+      o.Iterations = parseInt(arg, takeValue(), limits->GetNumberOfIterationsMinValue(),
+        limits->GetNumberOfIterationsMaxValue());
     }
     else if (arg == "--threads")
     {
@@ -615,6 +641,26 @@ int run(const Options& o, MessageCollector* messages)
   r.GeodesicThreshold = filter->GetGeodesicThreshold();
   r.AmplificationAlpha = filter->GetAmplificationAlpha();
   r.AmplificationBeta = filter->GetAmplificationBeta();
+  filter->SetOptimize(o.Optimize != "none");
+  if (o.Optimize == "spacing")
+  {
+    filter->SetEnergyToSpacing();
+  }
+  else
+  {
+    filter->SetEnergyToMIPS();
+  }
+  if (o.Spacing >= 0)
+  {
+    filter->SetTargetSpacing(o.Spacing);
+  }
+  if (o.Iterations >= 0)
+  {
+    filter->SetNumberOfIterations(o.Iterations);
+  }
+  r.Optimize = o.Optimize;
+  r.TargetSpacing = filter->GetTargetSpacing();
+  r.NumberOfIterations = filter->GetNumberOfIterations();
   r.Adaptivity = filter->GetAdaptivity();
   r.TargetNumberOfVertices = filter->GetTargetNumberOfVertices();
   r.MaximumRefinements = filter->GetMaximumRefinements();
@@ -635,6 +681,9 @@ int run(const Options& o, MessageCollector* messages)
   r.VerificationTime = filter->GetVerificationTime();
   r.SimplificationTime = filter->GetSimplificationTime();
   r.CageVerificationTime = filter->GetCageVerificationTime();
+  r.OptimizationTime = filter->GetOptimizationTime();
+  r.EnergyBefore = filter->GetEnergyBefore();
+  r.EnergyAfter = filter->GetEnergyAfter();
   r.VerticesReached = filter->GetVerticesReached();
   r.TargetReached = filter->GetTargetReached();
   r.StopReason = filter->GetStopReason();

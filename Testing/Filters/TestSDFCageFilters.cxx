@@ -46,6 +46,7 @@ int main(int argc, char* argv[])
   using namespace sdfcage_test;
   const std::map<std::string, std::function<int(const Context&)>> cases = {
     { "Sphere", TestSphere },
+    { "OptimizeFilter", TestOptimizeFilter },
     { "BuiltinShape", TestBuiltinShape },
     { "OpenInput", TestOpenInput },
     { "NoSurface", TestNoSurface },

@@ -124,6 +124,38 @@ message = bad.GetProperty("LastErrorMessageInfo").GetElement(0)
 print("error message:", message)
 check("boundary" in message, "open input: the message names boundary edges")
 
+# --- the Cage Optimize filter (two inputs: the cage and the source mesh) ------------------------
+check("CageOptimize" in globals() or "CageOptimizeFilter" in globals(), "the plugin defines CageOptimize()")
+opt = CageOptimize(Input=cage, Source=sphere)
+check(opt.Energy == "MIPS", "Energy default MIPS (got %s)" % opt.Energy)
+check(abs(opt.TargetSpacing - 0.05) < 1e-12, "TargetSpacing default 0.05")
+check(opt.NumberOfIterations == 1 and opt.EdgeFlips == 1, "one iteration with edge flips by default")
+for energy in ("MIPS", "Spacing"):
+    opt.Energy = energy
+    opt.TargetSpacing = 0.1
+    opt.UpdatePipeline()
+    oo = servermanager.Fetch(opt)
+    check(oo.GetNumberOfPoints() == out.GetNumberOfPoints(), "%s: same vertex count" % energy)
+    fd = oo.GetFieldData()
+    ostatus = fd.GetAbstractArray("Status")
+    check(ostatus is not None and ostatus.GetValue(0) == "Ok", "%s: status Ok" % energy)
+    before = fd.GetArray("EnergyBefore").GetValue(0)
+    after = fd.GetArray("EnergyAfter").GetValue(0)
+    check(after < before, "%s: energy lowered %g -> %g" % (energy, before, after))
+    od = oo.GetPointData().GetArray("DistanceToInput")
+    check(od is not None and od.GetRange()[0] >= fd.GetArray("MeasuredClearance").GetValue(0) * (1 - 1e-9),
+          "%s: DistanceToInput >= MeasuredClearance" % energy)
+    opt.UpdatePropertyInformation()
+    check(opt.GetProperty("EnergyAfterInfo").GetElement(0) == after, "%s: information property EnergyAfterInfo" % energy)
+
+# the optional step of SDF Cage
+cage2 = SDFCage(Input=sphere, IsoValue=0.04, Optimize=1, Energy="Spacing", TargetSpacing=0.1)
+cage2.UpdatePipeline()
+o2 = servermanager.Fetch(cage2)
+check(o2.GetFieldData().GetAbstractArray("Status").GetValue(0) == "Ok", "SDF Cage with Optimize: Ok")
+check(o2.GetFieldData().GetArray("EnergyAfter").GetValue(0) < o2.GetFieldData().GetArray("EnergyBefore").GetValue(0),
+      "SDF Cage with Optimize: energy lowered")
+
 # --- OFF writer and reader proxies -------------------------------------------------------------
 path = os.path.join(scratch, "pv_sphere.off")
 if os.path.exists(path):

@@ -81,6 +81,22 @@ def main(xml_path):
     for parameter in ("TargetNumberOfVertices", "IsoValue", "VoxelSize", "MinimumClearance", "Adaptivity", "MaximumRefinements",
                       "GenerateDistanceField", "NumberOfThreads"):
         check("Set" + parameter in commands, "vtkSDFCageFilter.%s has an XML property" % parameter)
+    for parameter in ("Optimize", "Energy", "TargetSpacing", "BarrierWeight", "BarrierDistance",
+                      "NumberOfIterations", "EdgeFlips"):
+        check("Set" + parameter in commands, "vtkSDFCageFilter.%s has an XML property" % parameter)
+    optimize_proxy = [p for p in proxies if p.get("class") == "vtkCageOptimizeFilter"]
+    check(len(optimize_proxy) == 1, "the XML declares vtkCageOptimizeFilter")
+    if optimize_proxy:
+        o = optimize_proxy[0]
+        ocommands = {p.get("command") for p in o}
+        for parameter in ("Energy", "TargetSpacing", "BarrierWeight", "BarrierDistance",
+                          "NumberOfIterations", "EdgeFlips", "MinimumClearance"):
+            check("Set" + parameter in ocommands, "vtkCageOptimizeFilter.%s has an XML property" % parameter)
+        inputs = {p.get("name"): p.get("command") for p in o.findall("InputProperty")}
+        check(inputs.get("Input") == "SetInputConnection", "the cage is Input: %s" % (inputs.get("Input"),))
+        check(inputs.get("Source") == "SetSourceConnection", "the mesh is Source: %s" % (inputs.get("Source"),))
+        menu = o.find("Hints/ShowInMenu")
+        check(menu is not None and menu.get("category") == "Cage Generation", "Cage Optimize in the menu")
     ports = [p.get("name") for p in filter_proxy.findall("OutputPort")]
     check(ports == ["Cage", "Envelope", "Distance Field"], "named output ports %s" % ports)
     menu = filter_proxy.find("Hints/ShowInMenu")

@@ -126,6 +126,30 @@ def test_off(scratch):
     check(sdfcage.vtkOFFReader.CanReadFile(path) == 1, "CanReadFile")
 
 
+def test_optimize():
+    source = sphere(2.0, 24)
+    cager = sdfcage.vtkSDFCageFilter()
+    cager.SetInputConnection(source.GetOutputPort())
+    cager.SetTargetNumberOfVertices(120)
+    opt = sdfcage.vtkCageOptimizeFilter()
+    opt.SetInputConnection(cager.GetOutputPort(0))
+    opt.SetSourceConnection(source.GetOutputPort())
+    opt.SetEnergyToSpacing()
+    opt.SetTargetSpacing(0.05)
+    opt.SetNumberOfIterations(2)
+    errors = Errors(opt, opt.GetExecutive())
+    opt.Update()
+    check(opt.GetStatusString() == "Ok", "optimize: status Ok (%s)" % opt.GetLastErrorMessage())
+    check(not errors.messages, "optimize: no errors")
+    out = opt.GetOutput()
+    check(out.GetNumberOfPoints() == 120, "optimize: same vertex count")
+    check(opt.GetEnergyAfter() < opt.GetEnergyBefore(),
+          "optimize: spacing energy lowered %g -> %g" % (opt.GetEnergyBefore(), opt.GetEnergyAfter()))
+    check(opt.GetMeasuredClearanceRelative() >= opt.GetClearanceUsed() * (1 - 1e-9),
+          "optimize: clearance kept")
+    check(out.GetPointData().GetArray("DistanceToInput") is not None, "optimize: DistanceToInput")
+
+
 if __name__ == "__main__":
     scratch = sys.argv[1] if len(sys.argv) > 1 else tempfile.mkdtemp()
     print("vtk", vtk.vtkVersion.GetVTKVersion(), "from", vtk.__file__)
@@ -133,4 +157,5 @@ if __name__ == "__main__":
     test_filter()
     test_errors()
     test_off(scratch)
+    test_optimize()
     print("all Python tests passed")

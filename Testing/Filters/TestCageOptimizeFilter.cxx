@@ -1,0 +1,116 @@
+// SDFCage — tests of vtkCageOptimizeFilter (cage + source mesh -> optimized cage) and of the
+// optimization step of vtkSDFCageFilter.
+#include "SDFCageTestUtilities.h"
+
+#include "vtkDoubleArray.h"
+#include "vtkExecutive.h"
+#include "vtkFieldData.h"
+#include "vtkPointData.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkCageOptimizeFilter.h"
+#include "vtkSDFCageFilter.h"
+#include "vtkStringArray.h"
+
+#include "Optimization.h" // Core: the default options the filter must mirror
+
+#include <cmath>
+
+namespace sdfcage_test
+{
+
+int TestOptimizeFilter(const Context&)
+{
+  Checker c("OptimizeFilter");
+  // a cage of a sphere from vtkSDFCageFilter, then optimized with both energies
+  vtkSmartPointer<vtkPolyData> sphere = MakeSphere(1.0, 24);
+  vtkNew<vtkSDFCageFilter> cager;
+  cager->SetInputData(sphere);
+  cager->SetTargetNumberOfVertices(150);
+  cager->Update();
+  vtkPolyData* cage = cager->GetOutput(0);
+  if (!c.Check(std::string(cager->GetStatusString()) == "Ok" && cage->GetNumberOfPoints() == 150,
+        "the cage to optimize was built"))
+  {
+    return c.Result();
+  }
+
+  vtkNew<vtkCageOptimizeFilter> filter;
+  const sdfcage::OptimizeOptions defaults;
+  c.Check(filter->GetEnergy() == vtkCageOptimizeFilter::MIPS, "Energy default MIPS");
+  c.Check(filter->GetTargetSpacing() == defaults.TargetSpacing, "TargetSpacing default is Core's");
+  c.Check(filter->GetBarrierWeight() == defaults.BarrierWeight, "BarrierWeight default is Core's");
+  c.Check(filter->GetBarrierDistance() == defaults.BarrierDistance, "BarrierDistance default is Core's");
+  c.Check(filter->GetNumberOfIterations() == defaults.NumberOfIterations, "NumberOfIterations default");
+  c.Check(filter->GetEdgeFlips() == 1, "EdgeFlips default on");
+  vtkNew<MessageRecorder> messages;
+  messages->Watch(filter);
+  messages->Watch(filter->GetExecutive()); // its "returned failure" report of the error case
+  filter->SetInputData(cage);
+  filter->SetSourceData(sphere);
+  for (int energy : { vtkCageOptimizeFilter::MIPS, vtkCageOptimizeFilter::SPACING })
+  {
+    const std::string name = energy == vtkCageOptimizeFilter::MIPS ? "MIPS" : "Spacing";
+    filter->SetEnergy(energy);
+    filter->SetTargetSpacing(0.03);
+    filter->Update();
+    vtkPolyData* out = filter->GetOutput();
+    c.Check(std::string(filter->GetStatusString()) == "Ok", name + ": status Ok, got " +
+        filter->GetStatusString() + " " + filter->GetLastErrorMessage());
+    c.Check(out->GetNumberOfPoints() == cage->GetNumberOfPoints() && out->GetNumberOfPolys() == cage->GetNumberOfPolys(),
+      name + ": same point and triangle counts");
+    c.Check(CountOpenEdges(out) == 0, name + ": closed and manifold");
+    c.Check(filter->GetEnergyAfter() < filter->GetEnergyBefore(),
+      name + ": energy lowered " + Str(filter->GetEnergyBefore()) + " -> " + Str(filter->GetEnergyAfter()));
+    c.Check(filter->GetNumberOfMoves() > 0, name + ": vertices moved");
+    c.Check(!filter->GetReverted(), name + ": not reverted");
+    c.Check(filter->GetMeasuredClearanceRelative() >= filter->GetClearanceUsed() * (1 - 1e-9),
+      name + ": clearance kept " + Str(filter->GetMeasuredClearanceRelative()) + " >= " +
+        Str(filter->GetClearanceUsed()));
+    auto* distance = vtkDoubleArray::SafeDownCast(out->GetPointData()->GetArray("DistanceToInput"));
+    if (c.Check(distance && distance->GetNumberOfTuples() == out->GetNumberOfPoints(), name + ": DistanceToInput"))
+    {
+      c.Check(distance->GetRange()[0] >= filter->GetMeasuredClearance() * (1 - 1e-9),
+        name + ": DistanceToInput >= MeasuredClearance");
+    }
+    auto* status = vtkStringArray::SafeDownCast(out->GetFieldData()->GetAbstractArray("Status"));
+    c.Check(status && status->GetValue(0) == "Ok", name + ": field data Status");
+    c.Check(out->GetFieldData()->GetArray("EnergyAfter") != nullptr, name + ": field data EnergyAfter");
+    c.Check(filter->GetOptimizationTime() > 0, name + ": time measured");
+  }
+  c.Check(messages->Errors.empty(), "no errors");
+
+  // errors: a "cage" inside the source is rejected with a clear message and an empty output
+  messages->Clear();
+  filter->SetInputData(MakeSphere(0.5, 12));
+  filter->Update();
+  c.Check(std::string(filter->GetStatusString()) == "InvalidInput", "a cage inside its source is invalid");
+  c.Check(messages->ErrorContains("does not enclose"), "the error says the cage does not enclose the input");
+  c.Check(filter->GetOutput()->GetNumberOfPoints() == 0, "empty output on error");
+
+  // no source: not an error, empty output
+  messages->Clear();
+  vtkNew<vtkCageOptimizeFilter> lonely;
+  messages->Watch(lonely);
+  lonely->SetInputData(cage);
+  lonely->Update();
+  c.Check(std::string(lonely->GetStatusString()) == "EmptyInput", "no source gives EmptyInput");
+  c.Check(lonely->GetOutput()->GetNumberOfPoints() == 0, "no source gives an empty output");
+  c.Check(messages->Errors.empty(), "no source is not an error");
+
+  // the optional step of vtkSDFCageFilter: off by default, on gives a verified, optimized cage
+  c.Check(cager->GetOptimize() == 0, "vtkSDFCageFilter: Optimize off by default");
+  cager->OptimizeOn();
+  cager->SetEnergyToSpacing();
+  cager->SetTargetSpacing(0.03);
+  cager->Update();
+  c.Check(std::string(cager->GetStatusString()) == "Ok", std::string("optimize step: status ") + cager->GetStatusString());
+  c.Check(cager->GetEnclosureVerified(), "optimize step: enclosure verified");
+  c.Check(cager->GetEnergyAfter() < cager->GetEnergyBefore(), "optimize step: energy lowered " +
+      Str(cager->GetEnergyBefore()) + " -> " + Str(cager->GetEnergyAfter()));
+  c.Check(cager->GetOutput(0)->GetNumberOfPoints() == 150, "optimize step keeps the vertex count");
+  c.Check(cager->GetOptimizationTime() > 0, "optimize step: time measured");
+  return c.Result();
+}
+
+} // namespace sdfcage_test
