@@ -88,6 +88,7 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
   result.NumberOfActivePoints = env.NumberOfActivePoints;
   result.NumberOfActiveSamples = env.NumberOfActiveSamples;
   result.ActivePointSeconds = env.ActivePointSeconds;
+  result.AmplificationSeconds = env.AmplificationSeconds;
   result.TopologyWarning = env.TopologyWarning;
   result.TotalSeconds = seconds(start);
   if (env.State != Status::Ok)

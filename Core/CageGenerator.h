@@ -45,6 +45,7 @@ struct CageResult
   std::size_t NumberOfActivePoints = 0;  ///< input points flagged active (0 when off)
   std::size_t NumberOfActiveSamples = 0; ///< the active set A on the surface sampling
   double ActivePointSeconds = 0.0;
+  double AmplificationSeconds = 0.0; ///< phi xi on the grid, part of DistanceFieldSeconds
   /// Non-empty when the envelope (and so the cage) does not have the input's genus and
   /// component count: parts closer than the parameters can separate were fused.
   std::string TopologyWarning;

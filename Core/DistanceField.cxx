@@ -355,11 +355,14 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
   {
     // xi^ = phi xi (eq. 2–3) wherever the isosurface xi^ = iso can lie or be interpolated from:
     // phi >= 1, so only where xi <= iso (plus a voxel for the interpolation).
+    const auto ta = std::chrono::steady_clock::now();
     noAdapt.reset(new openvdb::BoolTree(grid->tree(), false, openvdb::TopologyCopy()));
     out.AmplifiedVoxels = amplify(*grid, *closestTriangle, *amplification, voxelSize,
       static_cast<float>(iso + 2.0 * voxelSize), *noAdapt);
     openvdb::tools::dilateActiveValues(*noAdapt, 1);
     closestTriangle.reset();
+    out.AmplificationSeconds = seconds(ta);
+    out.DistanceFieldSeconds += out.AmplificationSeconds;
   }
 
   auto t1 = std::chrono::steady_clock::now();

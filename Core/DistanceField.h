@@ -27,6 +27,7 @@ struct IsosurfaceOutput
   double IsosurfaceSeconds = 0.0;
   std::size_t ActiveVoxels = 0;
   std::size_t AmplifiedVoxels = 0; ///< voxels whose value phi changed by more than 1e-3
+  double AmplificationSeconds = 0.0; ///< xi -> phi xi on the grid (part of DistanceFieldSeconds)
   double AcceptedAdaptivity = 0.0; ///< with a judge: the adaptivity of the accepted surface
   int Repairs = 0;                 ///< with a judge: re-extractions with a larger no-adaptivity region
 };

@@ -649,6 +649,7 @@ EnvelopeResult buildEnvelope(
     IsosurfaceOutput iso = computeIsosurface(
       unitInput, h, c, options.KeepDistanceField, progress, adaptivities, amplification, &judge, 4);
     result.AmplifiedVoxels = iso.AmplifiedVoxels;
+    result.AmplificationSeconds += iso.AmplificationSeconds;
     result.AdaptiveRepairs = iso.Repairs;
     result.DistanceFieldSeconds += iso.DistanceFieldSeconds;
     result.IsosurfaceSeconds += iso.IsosurfaceSeconds;

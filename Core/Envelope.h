@@ -94,6 +94,7 @@ struct EnvelopeResult
   std::size_t NumberOfActiveSamples = 0; ///< size of the active set A (samples)
   std::size_t AmplifiedVoxels = 0;       ///< voxels where phi > 1.001
   double ActivePointSeconds = 0.0;   ///< active points + g_A
+  double AmplificationSeconds = 0.0; ///< xi -> phi xi on the grid (included in DistanceFieldSeconds)
   int InputGenus = 0;
   int InputComponents = 0;
   /// Non-empty when the envelope's genus or component count differs from the input's (parts

@@ -28,7 +28,7 @@ namespace
 
 void usage()
 {
-  std::printf("usage: sdfcage_benchmark [--builtin] [--vertices N] [--iso C] [--voxel H] [--adaptivity A] "
+  std::printf("usage: sdfcage_benchmark [--builtin] [--vertices N] [--iso C] [--voxel H] [--adaptivity A] [--no-active-points] [--active-radius R] "
               "[--threads N] [FILE|FOLDER ...]\n"
               "  default: every mesh of %s\n",
     SDFCAGE_DATA_DIR);
@@ -77,7 +77,8 @@ int runOne(const std::string& name, const std::string& path, const CageOptions& 
   rusage ru{};
   getrusage(RUSAGE_SELF, &ru);
   const double peakMB = ru.ru_maxrss / 1024.0;
-  const double envelopeStage = r.ValidationSeconds + r.DistanceFieldSeconds + r.IsosurfaceSeconds + r.VerificationSeconds;
+  const double envelopeStage =
+    r.ValidationSeconds + r.ActivePointSeconds + r.DistanceFieldSeconds + r.IsosurfaceSeconds + r.VerificationSeconds;
   if (r.State == Status::Ok)
   {
     // Hausdorff relative to the input's bounding-box diagonal, measured in input units
@@ -87,8 +88,9 @@ int runOne(const std::string& name, const std::string& path, const CageOptions& 
     const double diagonal = (box[1] - box[0]).norm();
     const TriangleTree tree(in);
     const double hausdorff = r.Cage.empty() ? 0.0 : hausdorffCageToInput(r.Cage, tree, diagonal / 500.0) / diagonal;
-    std::printf("| %-24s | %8zu | %5.2f | %6.3f | %6.3f | %6.3f | %6.3f | **%6.3f** | %8zu | %6.3f | %6.3f | **%6.3f** | %5d | %7.5f | %7.5f | %d→%d→%d | %d | %7.0f | %s |\n",
-      name.c_str(), input.numberOfCells(), readSeconds, r.ValidationSeconds, r.DistanceFieldSeconds,
+    std::printf("| %-24s | %8zu | %5.2f | %6.3f | %zu (%zu) | %6.3f | %6.3f | %6.3f | %6.3f | **%6.3f** | %8zu | %6.3f | %6.3f | **%6.3f** | %5d | %7.5f | %7.5f | %d→%d→%d | %d | %7.0f | %s |\n",
+      name.c_str(), input.numberOfCells(), readSeconds, r.ValidationSeconds, r.NumberOfActivePoints,
+      r.NumberOfActiveSamples, r.ActivePointSeconds + r.AmplificationSeconds, r.DistanceFieldSeconds - r.AmplificationSeconds,
       r.IsosurfaceSeconds, r.VerificationSeconds, envelopeStage, r.Envelope.Triangles.size(),
       r.SimplificationSeconds, r.CageVerificationSeconds, r.TotalSeconds, r.VerticesReached,
       r.MinimumClearanceRelative, hausdorff, r.Defects.Genus, r.EnvelopeGenus, genus(r.Cage),
@@ -97,7 +99,7 @@ int runOne(const std::string& name, const std::string& path, const CageOptions& 
   else
   {
     std::string msg = r.Message.substr(0, 90);
-    std::printf("| %-24s | %8zu | %5.2f | %6.3f | — | — | — | %6.3f | — | — | — | %6.3f | — | — | — | — | — | %7.0f | %s: %s |\n",
+    std::printf("| %-24s | %8zu | %5.2f | %6.3f | — | — | — | — | — | %6.3f | — | — | — | %6.3f | — | — | — | — | — | %7.0f | %s: %s |\n",
       name.c_str(), input.numberOfCells(), readSeconds, r.ValidationSeconds, envelopeStage, r.TotalSeconds, peakMB,
       statusName(r.State), msg.c_str());
   }
@@ -137,6 +139,10 @@ int main(int argc, char** argv)
     }
     else if (a == "--adaptivity")
       value(options.Envelope.Adaptivity);
+    else if (a == "--no-active-points")
+      options.Envelope.UseActivePoints = false;
+    else if (a == "--active-radius")
+      value(options.Envelope.ActivePoints.Radius);
     else if (a == "--threads")
     {
       double t = 0;
@@ -181,13 +187,14 @@ int main(int argc, char** argv)
       return 2;
     }
   }
-  std::printf("c = %g, voxel = %g, adaptivity = %g, target vertices = %d, threads = %d (0 = all)\n\n",
+  std::printf("c = %g, voxel = %g, adaptivity = %g, active points %s (r %g), target vertices = %d, threads = %d (0 = all)\n\n",
     options.Envelope.IsoValue, options.Envelope.voxelSize(), options.Envelope.Adaptivity,
+    options.Envelope.UseActivePoints ? "on" : "off", options.Envelope.ActivePoints.Radius,
     options.TargetNumberOfVertices, options.Envelope.NumberOfThreads);
-  std::printf("| mesh | faces | read s | validate s | SDF s | isosurface s | verify s | envelope stage s | "
+  std::printf("| mesh | faces | read s | validate s | active pts (samples) | active + φξ s | SDF s | isosurface s | verify s | envelope stage s | "
               "envelope tris | simplify s | cage verify s | total s | cage verts | clearance (unit) | "
               "Hausdorff cage→input (/diag) | genus in→env→cage | pockets | peak MB | verified |\n");
-  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
   std::fflush(stdout);
   int failures = 0;
   for (const auto& m : meshes)
