@@ -37,11 +37,14 @@ SOURCE = os.path.normpath(os.path.join(HERE, "..", ".."))
 MESH_EXTENSIONS = (".off", ".obj", ".ply", ".stl", ".vtp", ".vtk")
 
 COLUMNS = [
-    ("mesh", "mesh"), ("faces", "input faces"), ("target", "N"), ("reached", "vertices"),
-    ("exit", "exit"), ("status", "status"),
+    ("mesh", "mesh"), ("faces", "input faces"), ("target", "N"), ("optimize", "optimize"),
+    ("reached", "vertices"), ("exit", "exit"), ("status", "status"),
+    ("active_points", "active points"), ("t_active_points", "active points s"),
     ("t_validation", "validation s"), ("t_distance_field", "SDF s"), ("t_isosurface", "isosurface s"),
     ("t_verification", "verification s"), ("t_simplification", "simplification s"),
-    ("t_cage_verification", "cage check s"), ("t_total", "total s"), ("peak_mb", "peak MB"),
+    ("t_cage_verification", "cage check s"), ("t_optimization", "optimization s"),
+    ("energy_before", "energy before"), ("energy_after", "energy after"),
+    ("t_total", "total s"), ("peak_mb", "peak MB"),
     ("clearance_rel", "clearance"), ("hausdorff_cage_input_rel", "H cage→input"),
     ("hausdorff_input_cage_rel", "H input→cage"), ("mean_distance_rel", "mean dist."),
     ("input_genus", "input genus"), ("cage_genus", "cage genus"), ("genus_kept", "genus kept"),
@@ -257,6 +260,8 @@ def main():
     parser.add_argument("inputs", nargs="*", help="meshes or folders (default: ../shared/data)")
     parser.add_argument("--builtin", action="store_true", help="also the built-in shape")
     parser.add_argument("--vertices", type=int, nargs="+", default=[200, 500, 1000])
+    parser.add_argument("--optimize", nargs="+", default=["none", "mips"], choices=["none", "mips", "spacing"],
+                        help="variants: without optimization and with each energy (none mips)")
     parser.add_argument("--out", default="benchmark", help="output folder (benchmark)")
     parser.add_argument("--sdfcage", default=os.path.join(SOURCE, "build", "bin", "sdfcage"))
     parser.add_argument("--timeout", type=float, default=1800, help="seconds per cage run")
@@ -296,15 +301,20 @@ def main():
                   os.path.splitext(os.path.basename(m))[0] in {r["mesh"] for r in rows}]
     for mesh in ([] if args.replot else meshes):
         stem = "builtin" if mesh == "builtin" else os.path.splitext(os.path.basename(mesh))[0]
-        for n in args.vertices:
-            cage = os.path.join(args.out, "cages", "%s_%d.vtp" % (stem, n))
-            report = os.path.join(args.out, "reports", "%s_%d.json" % (stem, n))
-            check = os.path.join(args.out, "reports", "%s_%d_check.json" % (stem, n))
+        for n, variant in [(n, v) for n in args.vertices for v in args.optimize]:
+            suffix = "" if variant == "none" else "_" + variant
+            cage = os.path.join(args.out, "cages", "%s_%d%s.vtp" % (stem, n, suffix))
+            report = os.path.join(args.out, "reports", "%s_%d%s.json" % (stem, n, suffix))
+            check = os.path.join(args.out, "reports", "%s_%d%s_check.json" % (stem, n, suffix))
             command = [args.sdfcage] + ([] if mesh == "builtin" else [mesh]) + [
-                "-n", str(n), "-o", cage, "--report", report, "--quiet"]
+                "-n", str(n), "-o", cage, "--report", report, "--quiet", "--optimize", variant]
             code, peak, seconds, err = run_measured(command, args.timeout)
             r = read_json(report)
-            row = {"mesh": stem, "faces": r.get("InputTriangles"), "target": n,
+            row = {"mesh": stem, "faces": r.get("InputTriangles"), "target": n, "optimize": variant,
+                   "active_points": r.get("NumberOfActivePoints"), "t_active_points": r.get("ActivePointTime"),
+                   "t_optimization": r.get("OptimizationTime") if variant != "none" else None,
+                   "energy_before": r.get("EnergyBefore") if variant != "none" else None,
+                   "energy_after": r.get("EnergyAfter") if variant != "none" else None,
                    "reached": r.get("VerticesReached"), "exit": code, "status": r.get("Status", err.strip()[:60]),
                    "t_validation": r.get("ValidationTime"), "t_distance_field": r.get("DistanceFieldTime"),
                    "t_isosurface": r.get("IsosurfaceTime"), "t_verification": r.get("VerificationTime"),
@@ -327,10 +337,10 @@ def main():
                         "encloses": q.get("Encloses") if q else (r.get("EnclosureVerified") if code == 0 else False),
                         "t_quality": q.get("QualityTime")})
             rows.append(row)
-            if code == 0:
+            if code == 0 and variant == "none":
                 distances[(stem, n)] = cage_distances(cage)
-            print("%-22s N=%-5d exit %d  %6.1f s  %7.1f MB  encloses %s" % (
-                stem, n, code, seconds, peak, fmt(row["encloses"])), flush=True)
+            print("%-22s N=%-5d %-8s exit %d  %6.1f s  %7.1f MB  encloses %s" % (
+                stem, n, variant, code, seconds, peak, fmt(row["encloses"])), flush=True)
 
     if not args.replot:
         write_tables(rows, args.out)
