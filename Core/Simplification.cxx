@@ -178,6 +178,7 @@ public:
   Simplifier(const TriangleMesh& mesh, const TriangleTree& input, const SimplifyOptions& o, Progress* p)
     : Input(input)
     , Opt(o)
+    , Original(o)
     , Prog(p)
   {
     P = mesh.Points;
@@ -219,6 +220,41 @@ public:
         if (static_cast<int>(v) < n)
           pushEdge(static_cast<int>(v), n);
     long long sinceProgress = 0;
+    // Pass 0 is the ordinary run. When the queue runs dry above the target, later passes retry
+    // every blocked edge with a more thorough placement search (pass 1) and then with relaxed
+    // shape bounds (pass 2, see relaxShape()); a pass that collapses something is repeated.
+    // The clearance and self-intersection tests are the same exact tests in every pass.
+    for (Pass = 0; Pass <= 2 && AliveVertices > target; ++Pass)
+    {
+      if (Pass > 0)
+      {
+        if (r.Cancelled || !requeueBlocked())
+          continue;
+        if (Pass == 2)
+          relaxShape();
+      }
+      const long long before = Stats.Collapses;
+      drain(target, start, sinceProgress, r);
+
+      if (Pass > 0 && Stats.Collapses > before && AliveVertices > target)
+        --Pass; // progress: try this pass again on what is now blocked
+    }
+    r = Stats;
+    r.Cancelled = r.Cancelled || progressCancelled(Prog);
+    r.VerticesReached = AliveVertices;
+    r.ReachedTarget = AliveVertices <= target;
+    if (!r.ReachedTarget)
+      r.StopReason = r.Cancelled ? "cancelled"
+                                 : "no remaining collapse keeps the clearance, self-intersection, "
+                                   "topology and shape constraints";
+    r.Cage = compact();
+    r.Seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return r;
+  }
+
+  // Pops and collapses edges until the target or an empty queue.
+  void drain(int target, int start, long long& sinceProgress, SimplifyResult& r)
+  {
     while (AliveVertices > target && !Heap.empty())
     {
       Entry e = Heap.top();
@@ -241,25 +277,21 @@ public:
         continue;
       }
       Vec3 pos = e.Pos;
-      Verdict v = check(pos);
-      if (v == Verdict::Input || v == Verdict::Self || v == Verdict::Shape)
+      const Verdict v = check(pos);
+      if (v != Verdict::Ok)
       {
         countReject(v);
-        if (v == Verdict::Input && relocate(pos))
-        {
-          ++Stats.Relocated;
-          const double cost = costAt(e.V0, e.V1, pos);
-          if (!Heap.empty() && cost > Heap.top().Cost)
-          {
-            // no longer the cheapest: queue it with its feasible placement
-            Heap.push({ cost, e.V0, e.V1, Ver[e.V0], Ver[e.V1], pos });
-            continue;
-          }
-          v = Verdict::Ok;
-        }
-        else
+        if (!place(pos, v))
         {
           block(e.V0, e.V1);
+          continue;
+        }
+        ++Stats.Relocated;
+        const double cost = costAt(e.V0, e.V1, pos);
+        if (!Heap.empty() && cost > Heap.top().Cost)
+        {
+          // no longer the cheapest: queue it with its feasible placement
+          Heap.push({ cost, e.V0, e.V1, Ver[e.V0], Ver[e.V1], pos });
           continue;
         }
       }
@@ -268,17 +300,99 @@ public:
       if (AliveTriangles * 2 < GridTriangles)
         rebuildGrid();
     }
-    r = Stats;
-    r.Cancelled = r.Cancelled || progressCancelled(Prog);
-    r.VerticesReached = AliveVertices;
-    r.ReachedTarget = AliveVertices <= target;
-    if (!r.ReachedTarget)
-      r.StopReason = r.Cancelled ? "cancelled"
-                                 : "no remaining collapse keeps the clearance, self-intersection, "
-                                   "topology and shape constraints";
-    r.Cage = compact();
-    r.Seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return r;
+  }
+
+  // Queues every blocked edge again; false if there is none.
+  bool requeueBlocked()
+  {
+    if (Blocked.empty())
+      return false;
+    std::vector<std::uint64_t> keys(Blocked.begin(), Blocked.end());
+    std::sort(keys.begin(), keys.end()); // the set's order is not deterministic across builds
+    Blocked.clear();
+    for (auto& l : BlockedAt)
+      l.clear();
+    for (std::uint64_t k : keys)
+    {
+      const int a = static_cast<int>(k >> 32), b = static_cast<int>(k & 0xFFFFFFFFu);
+      if (VAlive[a] && VAlive[b])
+        pushEdge(a, b);
+    }
+    return true;
+  }
+
+  // Late, when nothing else collapses: the normal bound drops to 0 (a new triangle may turn up
+  // to 90 degrees from the one it replaces, still no flip) and the needle bound to half. Folds,
+  // crossings and clearances are checked exactly as before.
+  void relaxShape()
+  {
+    Opt.MinimumNormalCosine = std::min(Opt.MinimumNormalCosine, 0.0);
+    Opt.MinimumTriangleQuality = 0.5 * Original.MinimumTriangleQuality;
+  }
+
+  // The placement `pos` of the gathered collapse failed with verdict `first`. Looks for a
+  // feasible one: the midpoint and the endpoints; the Psi descent from the placement (and, in the
+  // thorough passes, from the other starts); in the thorough passes, an outward walk along the
+  // one-ring's normal. Returns the cheapest found first in that order.
+  bool place(Vec3& pos, Verdict first)
+  {
+    const Vec3 starts[4] = { pos, 0.5 * (P[C0] + P[C1]), P[C0], P[C1] };
+    double bestCost = std::numeric_limits<double>::infinity();
+    Vec3 best = pos;
+    for (int i = 1; i < 4; ++i)
+    {
+      if (check(starts[i]) == Verdict::Ok)
+      {
+        const double c = costAt(C0, C1, starts[i]);
+        if (c < bestCost)
+        {
+          bestCost = c;
+          best = starts[i];
+        }
+      }
+    }
+    if (bestCost < std::numeric_limits<double>::infinity())
+    {
+      pos = best;
+      return true;
+    }
+    const int nStarts = Pass > 0 ? 4 : 1;
+    if (first == Verdict::Input || Pass > 0)
+      for (int i = 0; i < nStarts; ++i)
+      {
+        Vec3 p = starts[i];
+        if (relocate(p))
+        {
+          pos = p;
+          return true;
+        }
+      }
+    if (Pass == 0)
+      return false;
+    // outward walk: the area-weighted normal of the current one-ring of the edge
+    Vec3 n = Vec3::Zero();
+    for (int f : Changed)
+      n += (P[T[f][1]] - P[T[f][0]]).cross(P[T[f][2]] - P[T[f][0]]);
+    for (int f : Removed)
+      n += (P[T[f][1]] - P[T[f][0]]).cross(P[T[f][2]] - P[T[f][0]]);
+    if (!(n.norm() > 0))
+      return false;
+    n.normalize();
+    double reach = (P[C0] - P[C1]).norm();
+    for (int f : Changed)
+      for (int v : T[f])
+        reach = std::max(reach, (P[v] - P[C0]).norm());
+    for (int i = 0; i < 4; ++i)
+      for (double t = Opt.Clearance; t <= reach; t *= 2)
+      {
+        const Vec3 p = starts[i] + t * n;
+        if (check(p) == Verdict::Ok)
+        {
+          pos = p;
+          return true;
+        }
+      }
+    return false;
   }
 
 private:
@@ -677,6 +791,7 @@ private:
 
   const TriangleTree& Input;
   SimplifyOptions Opt;
+  const SimplifyOptions Original;
   Progress* Prog;
   std::vector<Vec3> P;
   std::vector<Triangle> T;
@@ -703,6 +818,7 @@ private:
   std::vector<std::vector<int>> BlockedAt;
   std::unordered_set<std::uint64_t> Blocked;
   SimplifyResult Stats;
+  int Pass = 0;
 };
 
 } // namespace
