@@ -336,39 +336,40 @@ public:
   // one-ring's normal. Returns the cheapest found first in that order.
   bool place(Vec3& pos, Verdict first)
   {
-    const Vec3 starts[4] = { pos, 0.5 * (P[C0] + P[C1]), P[C0], P[C1] };
-    double bestCost = std::numeric_limits<double>::infinity();
-    Vec3 best = pos;
-    for (int i = 1; i < 4; ++i)
+    // the ordinary pass keeps to the Psi descent from the placement when the input is too
+    // close: trying alternatives on every rejection of a dense envelope costs more than it gains
+    if (Pass == 0)
     {
-      if (check(starts[i]) == Verdict::Ok)
-      {
-        const double c = costAt(C0, C1, starts[i]);
-        if (c < bestCost)
-        {
-          bestCost = c;
-          best = starts[i];
-        }
-      }
-    }
-    if (bestCost < std::numeric_limits<double>::infinity())
-    {
-      pos = best;
+      if (first != Verdict::Input)
+        return false;
+      Vec3 p = pos;
+      if (!relocate(p))
+        return false;
+      pos = p;
       return true;
     }
-    const int nStarts = Pass > 0 ? 4 : 1;
-    if (first == Verdict::Input || Pass > 0)
-      for (int i = 0; i < nStarts; ++i)
+    const Vec3 starts[4] = { pos, 0.5 * (P[C0] + P[C1]), P[C0], P[C1] };
+    // the alternatives by increasing cost: the first feasible one is the cheapest
+    int order[3] = { 1, 2, 3 };
+    double cost[4];
+    for (int i = 1; i < 4; ++i)
+      cost[i] = costAt(C0, C1, starts[i]);
+    std::sort(order, order + 3, [&](int a, int b) { return cost[a] < cost[b] || (cost[a] == cost[b] && a < b); });
+    for (int i : order)
+      if (check(starts[i]) == Verdict::Ok)
       {
-        Vec3 p = starts[i];
-        if (relocate(p))
-        {
-          pos = p;
-          return true;
-        }
+        pos = starts[i];
+        return true;
       }
-    if (Pass == 0)
-      return false;
+    for (int i = 0; i < 4; ++i)
+    {
+      Vec3 p = starts[i];
+      if (relocate(p))
+      {
+        pos = p;
+        return true;
+      }
+    }
     // outward walk: the area-weighted normal of the current one-ring of the edge
     Vec3 n = Vec3::Zero();
     for (int f : Changed)
