@@ -190,6 +190,7 @@ public:
       for (int v : T[f])
         VT[v].push_back(static_cast<int>(f));
     Ver.assign(P.size(), 0);
+    D.assign(P.size(), -1.0);
     BlockedAt.assign(P.size(), {});
     Mark.assign(T.size(), 0);
     AliveVertices = static_cast<int>(P.size());
@@ -397,18 +398,30 @@ public:
   }
 
 private:
+  // exact distance from cage vertex v to the input, computed when first needed after v moved
+  double vertexDistance(int v)
+  {
+    if (D[v] < 0)
+      D[v] = Input.distance(P[v]);
+    return D[v];
+  }
+
   // ---- adjacency ----
   std::vector<int> neighbours(int v) const
   {
     std::vector<int> n;
-    n.reserve(16);
+    neighbours(v, n);
+    return n;
+  }
+  void neighbours(int v, std::vector<int>& n) const
+  {
+    n.clear();
     for (int f : VT[v])
       for (int w : T[f])
         if (w != v)
           n.push_back(w);
     std::sort(n.begin(), n.end());
     n.erase(std::unique(n.begin(), n.end()), n.end());
-    return n;
   }
 
   double costAt(int a, int b, const Vec3& p) const
@@ -460,6 +473,7 @@ private:
   // ---- the collapse being evaluated (v0 survives, v1 goes) ----
   int C0 = -1, C1 = -1;
   std::vector<int> Removed, Changed;
+  std::vector<int> N0, N1, Ring; // scratch
   unsigned MarkId = 0;
 
   bool gather(int v0, int v1)
@@ -485,13 +499,26 @@ private:
     if (Removed.size() != 2)
       return false;
     // link condition: the common neighbours of v0 and v1 are exactly the two opposite vertices
-    const std::vector<int> n0 = neighbours(v0), n1 = neighbours(v1);
-    std::vector<int> common;
-    std::set_intersection(n0.begin(), n0.end(), n1.begin(), n1.end(), std::back_inserter(common));
-    if (common.size() != 2)
+    neighbours(v0, N0);
+    neighbours(v1, N1);
+    std::size_t common = 0;
+    for (std::size_t i = 0, j = 0; i < N0.size() && j < N1.size();)
+    {
+      if (N0[i] < N1[j])
+        ++i;
+      else if (N1[j] < N0[i])
+        ++j;
+      else
+      {
+        ++common;
+        ++i;
+        ++j;
+      }
+    }
+    if (common != 2)
       return false;
     // keep at least a tetrahedron per component
-    if (n0.size() + n1.size() <= 6 && AliveVertices <= 4)
+    if (N0.size() + N1.size() <= 6 && AliveVertices <= 4)
       return false;
     ++MarkId;
     if (MarkId == 0)
@@ -521,6 +548,7 @@ private:
 
   Verdict check(const Vec3& p)
   {
+    LastCheckExact = false;
     const double delta = Opt.Clearance;
     const double selfDelta = Opt.selfClearance();
     NewTris.resize(Changed.size());
@@ -550,17 +578,39 @@ private:
     // distances through the tree.
     if (Opt.EnforceClearance)
     {
-      double reach = 0;
+      // Early-outs from the distance being 1-Lipschitz. A point x of a triangle with barycentric
+      // weights l_k satisfies sum_k l_k |x - v_k|^2 = sum_k l_k |v_k - o|^2 - |x - o|^2 for any o,
+      // so with o the centroid, the average of |x - v_k| is at most R (the corners' largest
+      // distance from the centroid) and d(x) >= sum_k l_k (D(v_k) - |x - v_k|) >= min_k D(v_k) - R.
+      // D(p) comes from one query bounded by delta + max R (beyond it, that bound is all we need);
+      // the other corners' distances are cached per vertex. Triangles the bound does not clear
+      // get the exact triangle-input distance through the tree.
+      double maxR = 0;
       for (const auto& nt : NewTris)
-        for (const Vec3& q : nt.Pts)
-          reach = std::max(reach, (q - p).norm());
+        maxR = std::max(maxR, nt.R);
+      const double limit = delta + maxR;
       Vec3 c;
       int tri;
-      double d;
-      if (Input.closestPoint(p, delta + reach, c, tri, d))
-        for (const auto& nt : NewTris)
-          if (Input.anyCloserThan(nt.Pts, delta))
-            return Verdict::Input;
+      double dp;
+      if (!Input.closestPoint(p, limit, c, tri, dp))
+        dp = limit;
+      else
+      {
+        LastCheckPos = p;
+        LastCheckDistance = dp;
+        LastCheckExact = true;
+      }
+      for (const auto& nt : NewTris)
+      {
+        double lo = dp;
+        for (int k = 0; k < 3 && lo - nt.R > delta * (1 + 1e-9); ++k)
+          if (nt.Ids[k] != C0)
+            lo = std::min(lo, vertexDistance(nt.Ids[k]));
+        if (lo - nt.R > delta * (1 + 1e-9))
+          continue;
+        if (Input.anyCloserThan(nt.Pts, delta))
+          return Verdict::Input;
+      }
     }
     if (!Opt.EnforceNoSelfIntersection)
       return Verdict::Ok;
@@ -610,11 +660,27 @@ private:
         // disjoint triangles whose bounding spheres are farther apart than selfDelta cannot conflict
         if (disjoint && (c.C - nt.C).norm() - c.R - nt.R >= selfDelta)
           continue;
+        // nor those a separating axis (the centroids' line, either normal) keeps selfDelta apart
+        if (disjoint && separated(nt.Pts, c.Pts, c.C - nt.C, selfDelta))
+          continue;
+        if (disjoint && (separated(nt.Pts, c.Pts, nt.N, selfDelta) || separated(nt.Pts, c.Pts, -nt.N, selfDelta)))
+          continue;
         if (trianglesConflict(nt.Ids, nt.Pts, c.Ids, c.Pts, selfDelta, FoldCosine))
           return Verdict::Self;
       }
     }
     return Verdict::Ok;
+  }
+
+  // Do the projections of a and b on axis u leave a gap of at least `gap`, b beyond a?
+  static bool separated(const Vec3 a[3], const Vec3 b[3], const Vec3& u, double gap)
+  {
+    const double n = u.norm();
+    if (!(n > 0))
+      return false;
+    const double amax = std::max({ u.dot(a[0]), u.dot(a[1]), u.dot(a[2]) });
+    const double bmin = std::min({ u.dot(b[0]), u.dot(b[1]), u.dot(b[2]) });
+    return bmin - amax >= gap * n * (1 + 1e-9);
   }
 
   // Gradient descent on Psi (eq. 5-6): move the placement so that the new one-ring moves away from
@@ -625,10 +691,11 @@ private:
     const double target = 2.0 * Opt.Clearance;
     static const double bary[7][3] = { { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 }, { .5, .5, 0 },
       { 0, .5, .5 }, { .5, 0, .5 }, { 1. / 3, 1. / 3, 1. / 3 } };
-    for (int it = 0; it < Opt.PlacementIterations; ++it)
+    for (int it = 0;; ++it)
     {
       Vec3 g = Vec3::Zero();
       double worst = target;
+      double nearest = target; // unsigned: a sample nearer than delta dooms check()
       for (int f : Changed)
       {
         int ids[3];
@@ -649,6 +716,7 @@ private:
           double d;
           if (!Input.closestPoint(x, target, c, tri, d))
             continue; // comfortably clear
+          nearest = std::min(nearest, d);
           Vec3 dir = d > 0 ? Vec3((x - c) / d) : Input.normal(tri);
           double xi = d;
           if (dir.dot(Input.normal(tri)) < 0) // inside the input: the gradient points outward
@@ -660,14 +728,16 @@ private:
           g += area * lp * (target - xi) * dir;
         }
       }
+      // the placement reached by the previous step: checked unless a sample already fails it
+      if (it > 0 && nearest >= Opt.Clearance && check(p) == Verdict::Ok)
+        return true;
+      if (it == Opt.PlacementIterations)
+        return false;
       const double gn = g.norm();
       if (!(gn > 0))
         return false;
       p += (g / gn) * (target - worst);
-      if (check(p) == Verdict::Ok)
-        return true;
     }
-    return false;
   }
 
   void countReject(Verdict v)
@@ -725,7 +795,9 @@ private:
       box(f, lo, hi);
       Grid.insert(f, lo, hi);
     }
-    const std::vector<int> ring = neighbours(C0);
+    D[C0] = LastCheckExact && LastCheckPos == p ? LastCheckDistance : -1.0;
+    neighbours(C0, Ring);
+    const std::vector<int>& ring = Ring;
     for (int v : { C0, C1 })
     {
       for (int n : BlockedAt[v])
@@ -799,6 +871,10 @@ private:
   std::vector<char> VAlive, TAlive;
   std::vector<std::vector<int>> VT;
   std::vector<Quadric> Q;
+  std::vector<double> D; // distance to the input per vertex, < 0 = not known
+  Vec3 LastCheckPos = Vec3::Zero();
+  double LastCheckDistance = -1;
+  bool LastCheckExact = false; // check() measured the exact distance of LastCheckPos
   std::vector<unsigned> Ver;
   std::vector<unsigned> Mark;
   std::vector<unsigned> Seen;
