@@ -474,6 +474,13 @@ private:
   int C0 = -1, C1 = -1;
   std::vector<int> Removed, Changed;
   std::vector<int> N0, N1, Ring; // scratch
+  struct Sample
+  {
+    bool Near = false; // the input lies within the descent's target distance
+    double D = 0, Xi = 0;
+    Vec3 Dir = Vec3::Zero();
+  };
+  std::vector<std::pair<int, Sample>> SampleCache;
   unsigned MarkId = 0;
 
   bool gather(int v0, int v1)
@@ -684,48 +691,72 @@ private:
   }
 
   // Gradient descent on Psi (eq. 5-6): move the placement so that the new one-ring moves away from
-  // the input where it is closer than the target (2 delta), sampling each new triangle at its
-  // corners, edge midpoints and centroid.
+  // the input where it is closer than the target (2 delta), sampling each new triangle where p
+  // weighs: at p, at the midpoints of its edges at p and at its centroid (weight = p's share).
   bool relocate(Vec3& p)
   {
     const double target = 2.0 * Opt.Clearance;
-    static const double bary[7][3] = { { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 }, { .5, .5, 0 },
-      { 0, .5, .5 }, { .5, 0, .5 }, { 1. / 3, 1. / 3, 1. / 3 } };
     for (int it = 0;; ++it)
     {
       Vec3 g = Vec3::Zero();
       double worst = target;
       double nearest = target; // unsigned: a sample nearer than delta dooms check()
+      // the corner p and the midpoints of the edges at p are shared by neighbouring triangles:
+      // each is measured once per step (key: -1 for p, the other end's id for a midpoint)
+      SampleCache.clear();
       for (int f : Changed)
       {
         int ids[3];
         Vec3 pts[3];
         newTriangle(f, p, ids, pts);
         const double area = 0.5 * (pts[1] - pts[0]).cross(pts[2] - pts[0]).norm();
-        for (const auto& b : bary)
+        int kp = 0;
+        while (ids[kp] != C0)
+          ++kp;
+        for (int s = 0; s < 4; ++s)
         {
-          double lp = 0;
-          for (int k = 0; k < 3; ++k)
-            if (ids[k] == C0)
-              lp = b[k];
-          if (lp == 0)
-            continue;
-          const Vec3 x = b[0] * pts[0] + b[1] * pts[1] + b[2] * pts[2];
-          Vec3 c;
-          int tri;
-          double d;
-          if (!Input.closestPoint(x, target, c, tri, d))
-            continue; // comfortably clear
-          nearest = std::min(nearest, d);
-          Vec3 dir = d > 0 ? Vec3((x - c) / d) : Input.normal(tri);
-          double xi = d;
-          if (dir.dot(Input.normal(tri)) < 0) // inside the input: the gradient points outward
+          // s = 0: p (weight 1); 1, 2: midpoints towards the other corners (1/2); 3: centroid (1/3)
+          const int other = s == 1 ? ids[(kp + 1) % 3] : s == 2 ? ids[(kp + 2) % 3] : -1;
+          const double lp = s == 0 ? 1.0 : s == 3 ? 1.0 / 3.0 : 0.5;
+          const int key = s == 0 ? -1 : other;
+          Sample smp;
+          bool cached = false;
+          if (s < 3)
+            for (const auto& kv : SampleCache)
+              if (kv.first == key)
+              {
+                smp = kv.second;
+                cached = true;
+                break;
+              }
+          if (!cached)
           {
-            dir = -dir;
-            xi = -d;
+            const Vec3 x = s == 0 ? p
+              : s == 3 ? Vec3((pts[0] + pts[1] + pts[2]) / 3.0)
+                       : Vec3(0.5 * (p + pts[s == 1 ? (kp + 1) % 3 : (kp + 2) % 3]));
+            Vec3 c;
+            int tri;
+            double d;
+            smp.Near = Input.closestPoint(x, target, c, tri, d);
+            if (smp.Near)
+            {
+              smp.D = d;
+              smp.Dir = d > 0 ? Vec3((x - c) / d) : Input.normal(tri);
+              smp.Xi = d;
+              if (smp.Dir.dot(Input.normal(tri)) < 0) // inside the input: the gradient points outward
+              {
+                smp.Dir = -smp.Dir;
+                smp.Xi = -d;
+              }
+            }
+            if (s < 3)
+              SampleCache.emplace_back(key, smp);
           }
-          worst = std::min(worst, xi);
-          g += area * lp * (target - xi) * dir;
+          if (!smp.Near)
+            continue; // comfortably clear
+          nearest = std::min(nearest, smp.D);
+          worst = std::min(worst, smp.Xi);
+          g += area * lp * (target - smp.Xi) * smp.Dir;
         }
       }
       // the placement reached by the previous step: checked unless a sample already fails it
