@@ -667,10 +667,9 @@ private:
         // disjoint triangles whose bounding spheres are farther apart than selfDelta cannot conflict
         if (disjoint && (c.C - nt.C).norm() - c.R - nt.R >= selfDelta)
           continue;
-        // nor those a separating axis (the centroids' line, either normal) keeps selfDelta apart
-        if (disjoint && separated(nt.Pts, c.Pts, c.C - nt.C, selfDelta))
-          continue;
-        if (disjoint && (separated(nt.Pts, c.Pts, nt.N, selfDelta) || separated(nt.Pts, c.Pts, -nt.N, selfDelta)))
+        // nor those a separating axis keeps selfDelta apart: the centroids' line, the normals,
+        // and (for the nearly coplanar neighbours of a flat region) the in-plane edge normals
+        if (disjoint && separatedByAxes(nt, c, selfDelta))
           continue;
         if (trianglesConflict(nt.Ids, nt.Pts, c.Ids, c.Pts, selfDelta, FoldCosine))
           return Verdict::Self;
@@ -679,15 +678,32 @@ private:
     return Verdict::Ok;
   }
 
-  // Do the projections of a and b on axis u leave a gap of at least `gap`, b beyond a?
+  // Do the projections of a and b on axis u leave a gap of at least `gap` (either order)? The
+  // distance of two convex sets is at least the gap of their projections on any axis.
   static bool separated(const Vec3 a[3], const Vec3 b[3], const Vec3& u, double gap)
   {
     const double n = u.norm();
     if (!(n > 0))
       return false;
-    const double amax = std::max({ u.dot(a[0]), u.dot(a[1]), u.dot(a[2]) });
-    const double bmin = std::min({ u.dot(b[0]), u.dot(b[1]), u.dot(b[2]) });
-    return bmin - amax >= gap * n * (1 + 1e-9);
+    const double a0 = u.dot(a[0]), a1 = u.dot(a[1]), a2 = u.dot(a[2]);
+    const double b0 = u.dot(b[0]), b1 = u.dot(b[1]), b2 = u.dot(b[2]);
+    const double g = gap * n * (1 + 1e-9);
+    return std::min({ b0, b1, b2 }) - std::max({ a0, a1, a2 }) >= g ||
+      std::min({ a0, a1, a2 }) - std::max({ b0, b1, b2 }) >= g;
+  }
+  template <typename A, typename B>
+  static bool separatedByAxes(const A& a, const B& b, double gap)
+  {
+    if (separated(a.Pts, b.Pts, b.C - a.C, gap) || separated(a.Pts, b.Pts, a.N, gap))
+      return true;
+    const Vec3 nb = (b.Pts[1] - b.Pts[0]).cross(b.Pts[2] - b.Pts[0]);
+    if (separated(a.Pts, b.Pts, nb, gap))
+      return true;
+    for (int k = 0; k < 3; ++k)
+      if (separated(a.Pts, b.Pts, a.N.cross(a.Pts[(k + 1) % 3] - a.Pts[k]), gap) ||
+        separated(a.Pts, b.Pts, nb.cross(b.Pts[(k + 1) % 3] - b.Pts[k]), gap))
+        return true;
+    return false;
   }
 
   // Gradient descent on Psi (eq. 5-6): move the placement so that the new one-ring moves away from
