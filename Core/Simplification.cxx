@@ -661,9 +661,23 @@ private:
       {
         if ((c.Lo.array() > hi.array()).any() || (c.Hi.array() < lo.array()).any())
           continue;
-        const bool disjoint = !(c.Ids[0] == nt.Ids[0] || c.Ids[0] == nt.Ids[1] || c.Ids[0] == nt.Ids[2] ||
-          c.Ids[1] == nt.Ids[0] || c.Ids[1] == nt.Ids[1] || c.Ids[1] == nt.Ids[2] ||
-          c.Ids[2] == nt.Ids[0] || c.Ids[2] == nt.Ids[1] || c.Ids[2] == nt.Ids[2]);
+        int shared = 0, ka = -1, kb = -1;
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j)
+            if (nt.Ids[i] == c.Ids[j])
+            {
+              ++shared;
+              ka = i;
+              kb = j;
+            }
+        const bool disjoint = shared == 0;
+        // sharing one vertex: they cannot meet elsewhere when the other two corners of one lie
+        // strictly on one side of the other's plane (by an angle far above rounding, so
+        // meetBeyondSharedVertex's nearly-coplanar case cannot apply)
+        if (shared == 1 &&
+          (oneSide(nt.Pts[ka], nt.N, c.Pts[(kb + 1) % 3], c.Pts[(kb + 2) % 3]) ||
+            oneSide(c.Pts[kb], (c.Pts[1] - c.Pts[0]).cross(c.Pts[2] - c.Pts[0]), nt.Pts[(ka + 1) % 3], nt.Pts[(ka + 2) % 3])))
+          continue;
         // disjoint triangles whose bounding spheres are farther apart than selfDelta cannot conflict
         if (disjoint && (c.C - nt.C).norm() - c.R - nt.R >= selfDelta)
           continue;
@@ -690,6 +704,16 @@ private:
     const double g = gap * n * (1 + 1e-9);
     return std::min({ b0, b1, b2 }) - std::max({ a0, a1, a2 }) >= g ||
       std::min({ a0, a1, a2 }) - std::max({ b0, b1, b2 }) >= g;
+  }
+  // Do d and e lie strictly on one side of the plane through a with normal n, each at an angle
+  // of at least 1e-6 radians from it as seen from a?
+  static bool oneSide(const Vec3& a, const Vec3& n, const Vec3& d, const Vec3& e)
+  {
+    const Vec3 ad = d - a, ae = e - a;
+    const double sd = n.dot(ad), se = n.dot(ae);
+    const double nn = n.norm();
+    const double td = 1e-6 * nn * ad.norm(), te = 1e-6 * nn * ae.norm();
+    return (sd > td && se > te) || (sd < -td && se < -te);
   }
   template <typename A, typename B>
   static bool separatedByAxes(const A& a, const B& b, double gap)
