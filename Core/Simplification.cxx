@@ -237,8 +237,10 @@ public:
       const long long before = Stats.Collapses;
       drain(target, start, sinceProgress, r);
 
-      if (Pass > 0 && Stats.Collapses > before && AliveVertices > target)
-        --Pass; // progress: try this pass again on what is now blocked
+      // progress: try this pass again on what is now blocked (a bounded number of times: each
+      // retry runs the thorough search on every blocked edge)
+      if (Pass > 0 && Stats.Collapses > before && AliveVertices > target && ++Retries <= MaxRetries)
+        --Pass;
     }
     r = Stats;
     r.Cancelled = r.Cancelled || progressCancelled(Prog);
@@ -398,11 +400,20 @@ public:
   }
 
 private:
-  // exact distance from cage vertex v to the input, computed when first needed after v moved
+  // distance from cage vertex v to the input (exact, or a lower bound when beyond a cap),
+  // computed when first needed after v moved
   double vertexDistance(int v)
   {
     if (D[v] < 0)
-      D[v] = Input.distance(P[v]);
+    {
+      // bounded query: beyond the cap, the cap itself is a valid lower bound and enough to clear
+      // any triangle of the dense and middle stages
+      const double cap = 16.0 * Opt.Clearance;
+      Vec3 c;
+      int tri;
+      double d;
+      D[v] = Input.closestPoint(P[v], cap, c, tri, d) ? d : cap;
+    }
     return D[v];
   }
 
@@ -942,7 +953,7 @@ private:
   std::vector<char> VAlive, TAlive;
   std::vector<std::vector<int>> VT;
   std::vector<Quadric> Q;
-  std::vector<double> D; // distance to the input per vertex, < 0 = not known
+  std::vector<double> D; // distance (or lower bound) to the input per vertex, < 0 = not known
   Vec3 LastCheckPos = Vec3::Zero();
   double LastCheckDistance = -1;
   bool LastCheckExact = false; // check() measured the exact distance of LastCheckPos
@@ -967,6 +978,8 @@ private:
   std::unordered_set<std::uint64_t> Blocked;
   SimplifyResult Stats;
   int Pass = 0;
+  int Retries = 0;
+  static constexpr int MaxRetries = 16;
 };
 
 } // namespace
