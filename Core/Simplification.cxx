@@ -178,6 +178,7 @@ public:
   Simplifier(const TriangleMesh& mesh, const TriangleTree& input, const SimplifyOptions& o, Progress* p)
     : Input(input)
     , Opt(o)
+    , Original(o)
     , Prog(p)
   {
     P = mesh.Points;
@@ -189,6 +190,7 @@ public:
       for (int v : T[f])
         VT[v].push_back(static_cast<int>(f));
     Ver.assign(P.size(), 0);
+    D.assign(P.size(), -1.0);
     BlockedAt.assign(P.size(), {});
     Mark.assign(T.size(), 0);
     AliveVertices = static_cast<int>(P.size());
@@ -219,6 +221,43 @@ public:
         if (static_cast<int>(v) < n)
           pushEdge(static_cast<int>(v), n);
     long long sinceProgress = 0;
+    // Pass 0 is the ordinary run. When the queue runs dry above the target, later passes retry
+    // every blocked edge with a more thorough placement search (pass 1) and then with relaxed
+    // shape bounds (pass 2, see relaxShape()); a pass that collapses something is repeated.
+    // The clearance and self-intersection tests are the same exact tests in every pass.
+    for (Pass = 0; Pass <= 2 && AliveVertices > target; ++Pass)
+    {
+      if (Pass > 0)
+      {
+        if (r.Cancelled || !requeueBlocked())
+          continue;
+        if (Pass == 2)
+          relaxShape();
+      }
+      const long long before = Stats.Collapses;
+      drain(target, start, sinceProgress, r);
+
+      // progress: try this pass again on what is now blocked (a bounded number of times: each
+      // retry runs the thorough search on every blocked edge)
+      if (Pass > 0 && Stats.Collapses > before && AliveVertices > target && ++Retries <= MaxRetries)
+        --Pass;
+    }
+    r = Stats;
+    r.Cancelled = r.Cancelled || progressCancelled(Prog);
+    r.VerticesReached = AliveVertices;
+    r.ReachedTarget = AliveVertices <= target;
+    if (!r.ReachedTarget)
+      r.StopReason = r.Cancelled ? "cancelled"
+                                 : "no remaining collapse keeps the clearance, self-intersection, "
+                                   "topology and shape constraints";
+    r.Cage = compact();
+    r.Seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return r;
+  }
+
+  // Pops and collapses edges until the target or an empty queue.
+  void drain(int target, int start, long long& sinceProgress, SimplifyResult& r)
+  {
     while (AliveVertices > target && !Heap.empty())
     {
       Entry e = Heap.top();
@@ -241,25 +280,21 @@ public:
         continue;
       }
       Vec3 pos = e.Pos;
-      Verdict v = check(pos);
-      if (v == Verdict::Input || v == Verdict::Self || v == Verdict::Shape)
+      const Verdict v = check(pos);
+      if (v != Verdict::Ok)
       {
         countReject(v);
-        if (v == Verdict::Input && relocate(pos))
-        {
-          ++Stats.Relocated;
-          const double cost = costAt(e.V0, e.V1, pos);
-          if (!Heap.empty() && cost > Heap.top().Cost)
-          {
-            // no longer the cheapest: queue it with its feasible placement
-            Heap.push({ cost, e.V0, e.V1, Ver[e.V0], Ver[e.V1], pos });
-            continue;
-          }
-          v = Verdict::Ok;
-        }
-        else
+        if (!place(pos, v))
         {
           block(e.V0, e.V1);
+          continue;
+        }
+        ++Stats.Relocated;
+        const double cost = costAt(e.V0, e.V1, pos);
+        if (!Heap.empty() && cost > Heap.top().Cost)
+        {
+          // no longer the cheapest: queue it with its feasible placement
+          Heap.push({ cost, e.V0, e.V1, Ver[e.V0], Ver[e.V1], pos });
           continue;
         }
       }
@@ -268,32 +303,136 @@ public:
       if (AliveTriangles * 2 < GridTriangles)
         rebuildGrid();
     }
-    r = Stats;
-    r.Cancelled = r.Cancelled || progressCancelled(Prog);
-    r.VerticesReached = AliveVertices;
-    r.ReachedTarget = AliveVertices <= target;
-    if (!r.ReachedTarget)
-      r.StopReason = r.Cancelled ? "cancelled"
-                                 : "no remaining collapse keeps the clearance, self-intersection, "
-                                   "topology and shape constraints";
-    r.Cage = compact();
-    r.Seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return r;
+  }
+
+  // Queues every blocked edge again; false if there is none.
+  bool requeueBlocked()
+  {
+    if (Blocked.empty())
+      return false;
+    std::vector<std::uint64_t> keys(Blocked.begin(), Blocked.end());
+    std::sort(keys.begin(), keys.end()); // the set's order is not deterministic across builds
+    Blocked.clear();
+    for (auto& l : BlockedAt)
+      l.clear();
+    for (std::uint64_t k : keys)
+    {
+      const int a = static_cast<int>(k >> 32), b = static_cast<int>(k & 0xFFFFFFFFu);
+      if (VAlive[a] && VAlive[b])
+        pushEdge(a, b);
+    }
+    return true;
+  }
+
+  // Late, when nothing else collapses: the normal bound drops to 0 (a new triangle may turn up
+  // to 90 degrees from the one it replaces, still no flip) and the needle bound to half. Folds,
+  // crossings and clearances are checked exactly as before.
+  void relaxShape()
+  {
+    Opt.MinimumNormalCosine = std::min(Opt.MinimumNormalCosine, 0.0);
+    Opt.MinimumTriangleQuality = 0.5 * Original.MinimumTriangleQuality;
+  }
+
+  // The placement `pos` of the gathered collapse failed with verdict `first`. Looks for a
+  // feasible one: the midpoint and the endpoints; the Psi descent from the placement (and, in the
+  // thorough passes, from the other starts); in the thorough passes, an outward walk along the
+  // one-ring's normal. Returns the cheapest found first in that order.
+  bool place(Vec3& pos, Verdict first)
+  {
+    // the ordinary pass keeps to the Psi descent from the placement when the input is too
+    // close: trying alternatives on every rejection of a dense envelope costs more than it gains
+    if (Pass == 0)
+    {
+      if (first != Verdict::Input)
+        return false;
+      Vec3 p = pos;
+      if (!relocate(p))
+        return false;
+      pos = p;
+      return true;
+    }
+    const Vec3 starts[4] = { pos, 0.5 * (P[C0] + P[C1]), P[C0], P[C1] };
+    // the alternatives by increasing cost: the first feasible one is the cheapest
+    int order[3] = { 1, 2, 3 };
+    double cost[4];
+    for (int i = 1; i < 4; ++i)
+      cost[i] = costAt(C0, C1, starts[i]);
+    std::sort(order, order + 3, [&](int a, int b) { return cost[a] < cost[b] || (cost[a] == cost[b] && a < b); });
+    for (int i : order)
+      if (check(starts[i]) == Verdict::Ok)
+      {
+        pos = starts[i];
+        return true;
+      }
+    for (int i = 0; i < 4; ++i)
+    {
+      Vec3 p = starts[i];
+      if (relocate(p))
+      {
+        pos = p;
+        return true;
+      }
+    }
+    // outward walk: the area-weighted normal of the current one-ring of the edge
+    Vec3 n = Vec3::Zero();
+    for (int f : Changed)
+      n += (P[T[f][1]] - P[T[f][0]]).cross(P[T[f][2]] - P[T[f][0]]);
+    for (int f : Removed)
+      n += (P[T[f][1]] - P[T[f][0]]).cross(P[T[f][2]] - P[T[f][0]]);
+    if (!(n.norm() > 0))
+      return false;
+    n.normalize();
+    double reach = (P[C0] - P[C1]).norm();
+    for (int f : Changed)
+      for (int v : T[f])
+        reach = std::max(reach, (P[v] - P[C0]).norm());
+    for (int i = 0; i < 4; ++i)
+      for (double t = Opt.Clearance; t <= reach; t *= 2)
+      {
+        const Vec3 p = starts[i] + t * n;
+        if (check(p) == Verdict::Ok)
+        {
+          pos = p;
+          return true;
+        }
+      }
+    return false;
   }
 
 private:
+  // distance from cage vertex v to the input (exact, or a lower bound when beyond a cap),
+  // computed when first needed after v moved
+  double vertexDistance(int v)
+  {
+    if (D[v] < 0)
+    {
+      // bounded query: beyond the cap, the cap itself is a valid lower bound and enough to clear
+      // any triangle of the dense and middle stages
+      const double cap = 16.0 * Opt.Clearance;
+      Vec3 c;
+      int tri;
+      double d;
+      D[v] = Input.closestPoint(P[v], cap, c, tri, d) ? d : cap;
+    }
+    return D[v];
+  }
+
   // ---- adjacency ----
   std::vector<int> neighbours(int v) const
   {
     std::vector<int> n;
-    n.reserve(16);
+    neighbours(v, n);
+    return n;
+  }
+  void neighbours(int v, std::vector<int>& n) const
+  {
+    n.clear();
     for (int f : VT[v])
       for (int w : T[f])
         if (w != v)
           n.push_back(w);
     std::sort(n.begin(), n.end());
     n.erase(std::unique(n.begin(), n.end()), n.end());
-    return n;
   }
 
   double costAt(int a, int b, const Vec3& p) const
@@ -345,6 +484,14 @@ private:
   // ---- the collapse being evaluated (v0 survives, v1 goes) ----
   int C0 = -1, C1 = -1;
   std::vector<int> Removed, Changed;
+  std::vector<int> N0, N1, Ring; // scratch
+  struct Sample
+  {
+    bool Near = false; // the input lies within the descent's target distance
+    double D = 0, Xi = 0;
+    Vec3 Dir = Vec3::Zero();
+  };
+  std::vector<std::pair<int, Sample>> SampleCache;
   unsigned MarkId = 0;
 
   bool gather(int v0, int v1)
@@ -370,13 +517,26 @@ private:
     if (Removed.size() != 2)
       return false;
     // link condition: the common neighbours of v0 and v1 are exactly the two opposite vertices
-    const std::vector<int> n0 = neighbours(v0), n1 = neighbours(v1);
-    std::vector<int> common;
-    std::set_intersection(n0.begin(), n0.end(), n1.begin(), n1.end(), std::back_inserter(common));
-    if (common.size() != 2)
+    neighbours(v0, N0);
+    neighbours(v1, N1);
+    std::size_t common = 0;
+    for (std::size_t i = 0, j = 0; i < N0.size() && j < N1.size();)
+    {
+      if (N0[i] < N1[j])
+        ++i;
+      else if (N1[j] < N0[i])
+        ++j;
+      else
+      {
+        ++common;
+        ++i;
+        ++j;
+      }
+    }
+    if (common != 2)
       return false;
     // keep at least a tetrahedron per component
-    if (n0.size() + n1.size() <= 6 && AliveVertices <= 4)
+    if (N0.size() + N1.size() <= 6 && AliveVertices <= 4)
       return false;
     ++MarkId;
     if (MarkId == 0)
@@ -406,6 +566,7 @@ private:
 
   Verdict check(const Vec3& p)
   {
+    LastCheckExact = false;
     const double delta = Opt.Clearance;
     const double selfDelta = Opt.selfClearance();
     NewTris.resize(Changed.size());
@@ -435,17 +596,39 @@ private:
     // distances through the tree.
     if (Opt.EnforceClearance)
     {
-      double reach = 0;
+      // Early-outs from the distance being 1-Lipschitz. A point x of a triangle with barycentric
+      // weights l_k satisfies sum_k l_k |x - v_k|^2 = sum_k l_k |v_k - o|^2 - |x - o|^2 for any o,
+      // so with o the centroid, the average of |x - v_k| is at most R (the corners' largest
+      // distance from the centroid) and d(x) >= sum_k l_k (D(v_k) - |x - v_k|) >= min_k D(v_k) - R.
+      // D(p) comes from one query bounded by delta + max R (beyond it, that bound is all we need);
+      // the other corners' distances are cached per vertex. Triangles the bound does not clear
+      // get the exact triangle-input distance through the tree.
+      double maxR = 0;
       for (const auto& nt : NewTris)
-        for (const Vec3& q : nt.Pts)
-          reach = std::max(reach, (q - p).norm());
+        maxR = std::max(maxR, nt.R);
+      const double limit = delta + maxR;
       Vec3 c;
       int tri;
-      double d;
-      if (Input.closestPoint(p, delta + reach, c, tri, d))
-        for (const auto& nt : NewTris)
-          if (Input.anyCloserThan(nt.Pts, delta))
-            return Verdict::Input;
+      double dp;
+      if (!Input.closestPoint(p, limit, c, tri, dp))
+        dp = limit;
+      else
+      {
+        LastCheckPos = p;
+        LastCheckDistance = dp;
+        LastCheckExact = true;
+      }
+      for (const auto& nt : NewTris)
+      {
+        double lo = dp;
+        for (int k = 0; k < 3 && lo - nt.R > delta * (1 + 1e-9); ++k)
+          if (nt.Ids[k] != C0)
+            lo = std::min(lo, vertexDistance(nt.Ids[k]));
+        if (lo - nt.R > delta * (1 + 1e-9))
+          continue;
+        if (Input.anyCloserThan(nt.Pts, delta))
+          return Verdict::Input;
+      }
     }
     if (!Opt.EnforceNoSelfIntersection)
       return Verdict::Ok;
@@ -489,11 +672,29 @@ private:
       {
         if ((c.Lo.array() > hi.array()).any() || (c.Hi.array() < lo.array()).any())
           continue;
-        const bool disjoint = !(c.Ids[0] == nt.Ids[0] || c.Ids[0] == nt.Ids[1] || c.Ids[0] == nt.Ids[2] ||
-          c.Ids[1] == nt.Ids[0] || c.Ids[1] == nt.Ids[1] || c.Ids[1] == nt.Ids[2] ||
-          c.Ids[2] == nt.Ids[0] || c.Ids[2] == nt.Ids[1] || c.Ids[2] == nt.Ids[2]);
+        int shared = 0, ka = -1, kb = -1;
+        for (int i = 0; i < 3; ++i)
+          for (int j = 0; j < 3; ++j)
+            if (nt.Ids[i] == c.Ids[j])
+            {
+              ++shared;
+              ka = i;
+              kb = j;
+            }
+        const bool disjoint = shared == 0;
+        // sharing one vertex: they cannot meet elsewhere when the other two corners of one lie
+        // strictly on one side of the other's plane (by an angle far above rounding, so
+        // meetBeyondSharedVertex's nearly-coplanar case cannot apply)
+        if (shared == 1 &&
+          (oneSide(nt.Pts[ka], nt.N, c.Pts[(kb + 1) % 3], c.Pts[(kb + 2) % 3]) ||
+            oneSide(c.Pts[kb], (c.Pts[1] - c.Pts[0]).cross(c.Pts[2] - c.Pts[0]), nt.Pts[(ka + 1) % 3], nt.Pts[(ka + 2) % 3])))
+          continue;
         // disjoint triangles whose bounding spheres are farther apart than selfDelta cannot conflict
         if (disjoint && (c.C - nt.C).norm() - c.R - nt.R >= selfDelta)
+          continue;
+        // nor those a separating axis keeps selfDelta apart: the centroids' line, the normals,
+        // and (for the nearly coplanar neighbours of a flat region) the in-plane edge normals
+        if (disjoint && separatedByAxes(nt, c, selfDelta))
           continue;
         if (trianglesConflict(nt.Ids, nt.Pts, c.Ids, c.Pts, selfDelta, FoldCosine))
           return Verdict::Self;
@@ -502,57 +703,123 @@ private:
     return Verdict::Ok;
   }
 
+  // Do the projections of a and b on axis u leave a gap of at least `gap` (either order)? The
+  // distance of two convex sets is at least the gap of their projections on any axis.
+  static bool separated(const Vec3 a[3], const Vec3 b[3], const Vec3& u, double gap)
+  {
+    const double n = u.norm();
+    if (!(n > 0))
+      return false;
+    const double a0 = u.dot(a[0]), a1 = u.dot(a[1]), a2 = u.dot(a[2]);
+    const double b0 = u.dot(b[0]), b1 = u.dot(b[1]), b2 = u.dot(b[2]);
+    const double g = gap * n * (1 + 1e-9);
+    return std::min({ b0, b1, b2 }) - std::max({ a0, a1, a2 }) >= g ||
+      std::min({ a0, a1, a2 }) - std::max({ b0, b1, b2 }) >= g;
+  }
+  // Do d and e lie strictly on one side of the plane through a with normal n, each at an angle
+  // of at least 1e-6 radians from it as seen from a?
+  static bool oneSide(const Vec3& a, const Vec3& n, const Vec3& d, const Vec3& e)
+  {
+    const Vec3 ad = d - a, ae = e - a;
+    const double sd = n.dot(ad), se = n.dot(ae);
+    const double nn = n.norm();
+    const double td = 1e-6 * nn * ad.norm(), te = 1e-6 * nn * ae.norm();
+    return (sd > td && se > te) || (sd < -td && se < -te);
+  }
+  template <typename A, typename B>
+  static bool separatedByAxes(const A& a, const B& b, double gap)
+  {
+    if (separated(a.Pts, b.Pts, b.C - a.C, gap) || separated(a.Pts, b.Pts, a.N, gap))
+      return true;
+    const Vec3 nb = (b.Pts[1] - b.Pts[0]).cross(b.Pts[2] - b.Pts[0]);
+    if (separated(a.Pts, b.Pts, nb, gap))
+      return true;
+    for (int k = 0; k < 3; ++k)
+      if (separated(a.Pts, b.Pts, a.N.cross(a.Pts[(k + 1) % 3] - a.Pts[k]), gap) ||
+        separated(a.Pts, b.Pts, nb.cross(b.Pts[(k + 1) % 3] - b.Pts[k]), gap))
+        return true;
+    return false;
+  }
+
   // Gradient descent on Psi (eq. 5-6): move the placement so that the new one-ring moves away from
-  // the input where it is closer than the target (2 delta), sampling each new triangle at its
-  // corners, edge midpoints and centroid.
+  // the input where it is closer than the target (2 delta), sampling each new triangle where p
+  // weighs: at p, at the midpoints of its edges at p and at its centroid (weight = p's share).
   bool relocate(Vec3& p)
   {
     const double target = 2.0 * Opt.Clearance;
-    static const double bary[7][3] = { { 1, 0, 0 }, { 0, 1, 0 }, { 0, 0, 1 }, { .5, .5, 0 },
-      { 0, .5, .5 }, { .5, 0, .5 }, { 1. / 3, 1. / 3, 1. / 3 } };
-    for (int it = 0; it < Opt.PlacementIterations; ++it)
+    for (int it = 0;; ++it)
     {
       Vec3 g = Vec3::Zero();
       double worst = target;
+      double nearest = target; // unsigned: a sample nearer than delta dooms check()
+      // the corner p and the midpoints of the edges at p are shared by neighbouring triangles:
+      // each is measured once per step (key: -1 for p, the other end's id for a midpoint)
+      SampleCache.clear();
       for (int f : Changed)
       {
         int ids[3];
         Vec3 pts[3];
         newTriangle(f, p, ids, pts);
         const double area = 0.5 * (pts[1] - pts[0]).cross(pts[2] - pts[0]).norm();
-        for (const auto& b : bary)
+        int kp = 0;
+        while (ids[kp] != C0)
+          ++kp;
+        for (int s = 0; s < 4; ++s)
         {
-          double lp = 0;
-          for (int k = 0; k < 3; ++k)
-            if (ids[k] == C0)
-              lp = b[k];
-          if (lp == 0)
-            continue;
-          const Vec3 x = b[0] * pts[0] + b[1] * pts[1] + b[2] * pts[2];
-          Vec3 c;
-          int tri;
-          double d;
-          if (!Input.closestPoint(x, target, c, tri, d))
-            continue; // comfortably clear
-          Vec3 dir = d > 0 ? Vec3((x - c) / d) : Input.normal(tri);
-          double xi = d;
-          if (dir.dot(Input.normal(tri)) < 0) // inside the input: the gradient points outward
+          // s = 0: p (weight 1); 1, 2: midpoints towards the other corners (1/2); 3: centroid (1/3)
+          const int other = s == 1 ? ids[(kp + 1) % 3] : s == 2 ? ids[(kp + 2) % 3] : -1;
+          const double lp = s == 0 ? 1.0 : s == 3 ? 1.0 / 3.0 : 0.5;
+          const int key = s == 0 ? -1 : other;
+          Sample smp;
+          bool cached = false;
+          if (s < 3)
+            for (const auto& kv : SampleCache)
+              if (kv.first == key)
+              {
+                smp = kv.second;
+                cached = true;
+                break;
+              }
+          if (!cached)
           {
-            dir = -dir;
-            xi = -d;
+            const Vec3 x = s == 0 ? p
+              : s == 3 ? Vec3((pts[0] + pts[1] + pts[2]) / 3.0)
+                       : Vec3(0.5 * (p + pts[s == 1 ? (kp + 1) % 3 : (kp + 2) % 3]));
+            Vec3 c;
+            int tri;
+            double d;
+            smp.Near = Input.closestPoint(x, target, c, tri, d);
+            if (smp.Near)
+            {
+              smp.D = d;
+              smp.Dir = d > 0 ? Vec3((x - c) / d) : Input.normal(tri);
+              smp.Xi = d;
+              if (smp.Dir.dot(Input.normal(tri)) < 0) // inside the input: the gradient points outward
+              {
+                smp.Dir = -smp.Dir;
+                smp.Xi = -d;
+              }
+            }
+            if (s < 3)
+              SampleCache.emplace_back(key, smp);
           }
-          worst = std::min(worst, xi);
-          g += area * lp * (target - xi) * dir;
+          if (!smp.Near)
+            continue; // comfortably clear
+          nearest = std::min(nearest, smp.D);
+          worst = std::min(worst, smp.Xi);
+          g += area * lp * (target - smp.Xi) * smp.Dir;
         }
       }
+      // the placement reached by the previous step: checked unless a sample already fails it
+      if (it > 0 && nearest >= Opt.Clearance && check(p) == Verdict::Ok)
+        return true;
+      if (it == Opt.PlacementIterations)
+        return false;
       const double gn = g.norm();
       if (!(gn > 0))
         return false;
       p += (g / gn) * (target - worst);
-      if (check(p) == Verdict::Ok)
-        return true;
     }
-    return false;
   }
 
   void countReject(Verdict v)
@@ -610,7 +877,9 @@ private:
       box(f, lo, hi);
       Grid.insert(f, lo, hi);
     }
-    const std::vector<int> ring = neighbours(C0);
+    D[C0] = LastCheckExact && LastCheckPos == p ? LastCheckDistance : -1.0;
+    neighbours(C0, Ring);
+    const std::vector<int>& ring = Ring;
     for (int v : { C0, C1 })
     {
       for (int n : BlockedAt[v])
@@ -677,12 +946,17 @@ private:
 
   const TriangleTree& Input;
   SimplifyOptions Opt;
+  const SimplifyOptions Original;
   Progress* Prog;
   std::vector<Vec3> P;
   std::vector<Triangle> T;
   std::vector<char> VAlive, TAlive;
   std::vector<std::vector<int>> VT;
   std::vector<Quadric> Q;
+  std::vector<double> D; // distance (or lower bound) to the input per vertex, < 0 = not known
+  Vec3 LastCheckPos = Vec3::Zero();
+  double LastCheckDistance = -1;
+  bool LastCheckExact = false; // check() measured the exact distance of LastCheckPos
   std::vector<unsigned> Ver;
   std::vector<unsigned> Mark;
   std::vector<unsigned> Seen;
@@ -703,6 +977,9 @@ private:
   std::vector<std::vector<int>> BlockedAt;
   std::unordered_set<std::uint64_t> Blocked;
   SimplifyResult Stats;
+  int Pass = 0;
+  int Retries = 0;
+  static constexpr int MaxRetries = 16;
 };
 
 } // namespace

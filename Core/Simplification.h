@@ -28,9 +28,14 @@ struct SimplifyOptions
   /// equilateral, must be at least this (0.02 is a minimum angle of roughly 0.7 degrees).
   double MinimumTriangleQuality = 0.02;
   /// A new triangle's normal must stay within this angle of the triangle it replaces: cos = 0.2
-  /// (about 78 degrees) forbids flips and near-flips.
+  /// (about 78 degrees) forbids flips and near-flips. When no collapse is left above the target,
+  /// a last pass relaxes this bound to min(this, 0) and the needle bound to half (folds,
+  /// crossings and clearances stay checked exactly).
   double MinimumNormalCosine = 0.2;
   /// Gradient steps on Psi (eq. 5-6) to move an infeasible placement into the feasible region.
+  /// An infeasible placement is first replaced by the edge's midpoint or an endpoint when one of
+  /// them is feasible; when the queue runs dry above the target, the blocked edges are retried
+  /// with the descent started from all of these and an outward walk along the one-ring normal.
   int PlacementIterations = 8;
   /// For comparisons only: turning these off gives plain (unconstrained) QEM, which does not
   /// keep the guarantees. Link condition, flip and needle checks stay on.
@@ -52,7 +57,7 @@ struct SimplifyResult
   long long RejectedSelf = 0;      ///< ... by self-intersection / self clearance
   long long RejectedTopology = 0;  ///< ... by the link condition
   long long RejectedShape = 0;     ///< ... by flips or needles
-  long long Relocated = 0;         ///< placements made feasible by the Psi descent
+  long long Relocated = 0;         ///< infeasible placements replaced by a feasible one
   double Seconds = 0.0;
 };
 

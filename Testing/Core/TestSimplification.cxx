@@ -99,6 +99,29 @@ TEST(Simplification, ExactVertexCountsAndGuarantees)
   }
 }
 
+TEST(Simplification, CoarseTargetsAreReached)
+{
+  // Coarse cages need vertices far outside the envelope (a 50-vertex torus cage sags by tens of
+  // clearances between its vertices): the placement search must find them. The count must be
+  // exact and the cage valid for the independent checker.
+  const std::vector<std::pair<Case, int>> coarse = {
+    { { "sphere", [] { return makeSphere(Vec3(0, 0, 0), 1.0, 24, 12); } }, 50 },
+    { { "torus", [] { return makeTorus(Vec3(0, 0, 0), 1.0, 0.3, 64, 24); } }, 50 },
+    { { "torus", [] { return makeTorus(Vec3(0, 0, 0), 1.0, 0.3, 64, 24); } }, 16 },
+  };
+  for (const auto& c : coarse)
+  {
+    const TriangleMesh input = c.first.Make();
+    CageOptions o;
+    o.TargetNumberOfVertices = c.second;
+    const CageResult r = generateCage(PolygonMesh::fromTriangles(input), o);
+    const std::string what = c.first.Name + " @" + std::to_string(c.second);
+    expectValidCage(input, r, what);
+    EXPECT_TRUE(r.TargetReached) << what << ": " << r.StopReason;
+    EXPECT_EQ(static_cast<int>(r.Cage.Points.size()), c.second) << what;
+  }
+}
+
 TEST(Simplification, PlainQEMFailsWhereConstrainedPasses)
 {
   // (the comb of makeComb() shows the same, but its envelope needs the dense non-adaptive grid,

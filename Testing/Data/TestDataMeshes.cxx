@@ -1,6 +1,6 @@
 // SDFCage — Testing: generateCage on one real mesh, judged by the CGAL checker.
 //
-//   SDFCageDataTests --mesh=FILE --expect=cage|invalid [--inward] [gtest flags]
+//   SDFCageDataTests --mesh=FILE --expect=cage|invalid [--inward] [--vertices=N] [gtest flags]
 //   SDFCageDataTests --data-dir=DIR        (no mesh: reports SKIPPED, naming the folder)
 //
 // --expect=cage: the mesh is closed; the run must end Ok with a verified envelope, and the exact
@@ -8,7 +8,7 @@
 // strictly enclose the input at the promised clearance; the cage must have the requested vertex
 // count or a stop reason. --expect=invalid: the mesh is not watertight; the run must end
 // with InvalidInput and a message naming the boundary edges. --inward: the mesh faces inward and
-// validation must flip it.
+// validation must flip it. --vertices=N: the cage's vertex count (default: CageOptions' 500).
 #include "../Core/CoreTestPrinters.h"
 #include "CageGenerator.h"
 #include "ExactCheck.h"
@@ -31,6 +31,7 @@ std::string gMesh;
 std::string gDataDir;
 std::string gExpect = "cage";
 bool gInward = false;
+int gVertices = -1; // < 0: the default of CageOptions
 
 double since(std::chrono::steady_clock::time_point t0)
 {
@@ -68,6 +69,10 @@ TEST(DataMesh, GenerateCage)
   ASSERT_GT(polygons.numberOfCells(), 0u);
 
   CageOptions options;
+  if (gVertices >= 0)
+  {
+    options.TargetNumberOfVertices = gVertices;
+  }
   t0 = std::chrono::steady_clock::now();
   const CageResult result = generateCage(polygons, options);
   const double cageSeconds = since(t0);
@@ -201,6 +206,10 @@ int main(int argc, char** argv)
     else if (arg.rfind("--expect=", 0) == 0)
     {
       gExpect = arg.substr(9);
+    }
+    else if (arg.rfind("--vertices=", 0) == 0)
+    {
+      gVertices = std::stoi(arg.substr(11));
     }
     else if (arg == "--inward")
     {
