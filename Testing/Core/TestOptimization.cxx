@@ -12,6 +12,8 @@
 
 #include <gtest/gtest.h>
 
+#include <mutex>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -342,14 +344,17 @@ TEST(Optimization, CancelInsideGenerateCage)
   class CancelDuringOptimization : public Progress
   {
   protected:
+    // report() may be called from any worker thread (Progress's contract): guard the list
     void report(double, const std::string& stage) override
     {
+      std::lock_guard<std::mutex> guard(Lock);
       Stages.push_back(stage);
       if (stage == "relocating cage vertices")
         this->cancel();
     }
 
   public:
+    std::mutex Lock;
     std::vector<std::string> Stages;
   };
   const TriangleMesh input = makeTorus(Vec3(0, 0, 0), 1.0, 0.3, 64, 24);
