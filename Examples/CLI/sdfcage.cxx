@@ -85,7 +85,7 @@ void printUsage(std::ostream& os)
         "      --clearance D       clearance every cage triangle keeps from the input,\n"
         "                          default 0 = automatic (C/4)\n"
         "      --adaptivity A      isosurface adaptivity in [0, 1]: 0 uniform triangles, larger\n"
-        "                          merges flat regions (fewer triangles); default 0.1\n"
+        "                          merges flat regions (fewer triangles); default 0.3\n"
         "      --refinements N     times the grid may be refined if verification fails, default 2\n"
         "      --no-active-points  plain offset envelope: no active points, no amplified SDF\n"
         "                          (nearly touching parts may fuse)\n"

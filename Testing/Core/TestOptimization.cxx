@@ -54,7 +54,12 @@ void expectGuarantees(const TriangleMesh& input, const TriangleMesh& before, con
   EXPECT_EQ(e.CageGenus, e0.CageGenus) << what;
   EXPECT_EQ(e.CageComponents, e0.CageComponents) << what;
   EXPECT_GE(e.MinimumClearance, deltaInputUnits * (1 - 1e-9)) << what;
-  EXPECT_NEAR(r.MinimumClearance, e.MinimumClearance, 1e-6 * deltaInputUnits + 1e-12) << what;
+  // the exact check measures clearances up to its cap (4 delta) and reports the cap beyond it
+  const double cap = 4 * deltaInputUnits;
+  if (e.MinimumClearance < cap * (1 - 1e-9))
+    EXPECT_NEAR(r.MinimumClearance, e.MinimumClearance, 1e-6 * deltaInputUnits + 1e-12) << what;
+  else
+    EXPECT_GE(r.MinimumClearance, cap * (1 - 1e-6)) << what;
   ASSERT_EQ(r.DistanceToInput.size(), r.Cage.Points.size()) << what;
   EXPECT_TRUE(r.Moves > 0 || r.Flips > 0) << what << ": nothing changed";
 }
