@@ -13,6 +13,9 @@
 #include <unordered_map>
 #include <unordered_set>
 
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
 namespace sdfcage
 {
 
@@ -83,7 +86,7 @@ public:
   }
   double cellSize() const { return Cell; }
   template <typename F>
-  void forCells(const Vec3& lo, const Vec3& hi, F&& f)
+  void forCells(const Vec3& lo, const Vec3& hi, F&& f) const
   {
     const std::int64_t i0 = key1(lo.x()), i1 = key1(hi.x());
     const std::int64_t j0 = key1(lo.y()), j1 = key1(hi.y());
@@ -113,7 +116,7 @@ public:
     });
   }
   template <typename F>
-  void query(const Vec3& lo, const Vec3& hi, F&& f)
+  void query(const Vec3& lo, const Vec3& hi, F&& f) const
   {
     forCells(lo, hi, [&](std::int64_t key) {
       auto it = Cells.find(key);
@@ -172,6 +175,72 @@ double triangleQuality(const Vec3& a, const Vec3& b, const Vec3& c)
 // Neighbouring cage triangles whose dihedral angle closes below ~18 degrees count as folded.
 constexpr double FoldCosine = -0.95;
 
+// Candidate collapses evaluated together. The batch is formed, evaluated and applied the same way
+// whatever the number of threads, so the cage does not depend on it.
+constexpr int BatchSize = 32;
+
+struct Sample
+{
+  bool Near = false; // the input lies within the descent's target distance
+  double D = 0, Xi = 0;
+  Vec3 Dir = Vec3::Zero();
+};
+
+struct NewTri
+{
+  int Ids[3];
+  Vec3 Pts[3];
+  Vec3 N;
+  Vec3 C;   // centroid
+  double R; // bounding radius about C
+};
+
+struct Candidate
+{
+  int F;
+  int Ids[3];
+  Vec3 Pts[3];
+  Vec3 Lo, Hi, C;
+  double R;
+};
+
+// Per-thread scratch of the evaluation (per-triangle stamps and reusable buffers).
+struct Scratch
+{
+  explicit Scratch(std::size_t triangles = 0)
+    : Mark(triangles, 0)
+    , Seen(triangles, 0)
+  {
+  }
+  std::vector<unsigned> Mark, Seen; // triangle stamps: of the collapse; already a candidate
+  unsigned MarkId = 0, QueryId = 0;
+  std::vector<int> N0, N1;
+  std::vector<NewTri> NewTris;
+  std::vector<Candidate> Candidates;
+  std::vector<std::pair<int, Sample>> SampleCache;
+};
+
+// One candidate collapse and everything its evaluation found and read. Evaluations only read the
+// cage; what they learn is applied afterwards, in the batch's order, by one thread.
+struct Eval
+{
+  Entry E;
+  int C0 = -1, C1 = -1; // v0 survives, v1 goes
+  std::vector<int> Removed, Changed;
+  std::vector<int> Verts; // C0, C1 and their neighbours: the vertices the evaluation read
+  bool Gathered = false, Feasible = false, Relocated = false;
+  Vec3 Pos = Vec3::Zero();
+  double Cost = 0;
+  bool HasRead = false; // the cage triangles read lie within [ReadLo, ReadHi]
+  Vec3 ReadLo = Vec3::Zero(), ReadHi = Vec3::Zero();
+  std::vector<std::pair<int, double>> Dist; // vertex distances to the input measured
+  Vec3 LastCheckPos = Vec3::Zero();
+  double LastCheckDistance = -1;
+  bool LastCheckExact = false; // check() measured the exact distance of LastCheckPos
+  long long RejInput = 0, RejSelf = 0, RejShape = 0;
+  Scratch* S = nullptr;
+};
+
 class Simplifier
 {
 public:
@@ -180,6 +249,7 @@ public:
     , Opt(o)
     , Original(o)
     , Prog(p)
+    , Scratches(Scratch(mesh.Triangles.size()))
   {
     P = mesh.Points;
     T = mesh.Triangles;
@@ -191,8 +261,8 @@ public:
         VT[v].push_back(static_cast<int>(f));
     Ver.assign(P.size(), 0);
     D.assign(P.size(), -1.0);
+    VStamp.assign(P.size(), 0);
     BlockedAt.assign(P.size(), {});
-    Mark.assign(T.size(), 0);
     AliveVertices = static_cast<int>(P.size());
     AliveTriangles = static_cast<int>(T.size());
     Q.assign(P.size(), Quadric());
@@ -220,7 +290,6 @@ public:
       for (int n : neighbours(static_cast<int>(v)))
         if (static_cast<int>(v) < n)
           pushEdge(static_cast<int>(v), n);
-    long long sinceProgress = 0;
     // Pass 0 is the ordinary run. When the queue runs dry above the target, later passes retry
     // every blocked edge with a more thorough placement search (pass 1) and then with relaxed
     // shape bounds (pass 2, see relaxShape()); a pass that collapses something is repeated.
@@ -235,15 +304,16 @@ public:
           relaxShape();
       }
       const long long before = Stats.Collapses;
-      drain(target, start, sinceProgress, r);
+      drain(target, start, r);
 
       // progress: try this pass again on what is now blocked (a bounded number of times: each
       // retry runs the thorough search on every blocked edge)
       if (Pass > 0 && Stats.Collapses > before && AliveVertices > target && ++Retries <= MaxRetries)
         --Pass;
     }
+    const bool cancelled = r.Cancelled;
     r = Stats;
-    r.Cancelled = r.Cancelled || progressCancelled(Prog);
+    r.Cancelled = cancelled || progressCancelled(Prog);
     r.VerticesReached = AliveVertices;
     r.ReachedTarget = AliveVertices <= target;
     if (!r.ReachedTarget)
@@ -255,54 +325,164 @@ public:
     return r;
   }
 
-  // Pops and collapses edges until the target or an empty queue.
-  void drain(int target, int start, long long& sinceProgress, SimplifyResult& r)
+  // Pops and collapses edges until the target or an empty queue, a batch at a time: the cheapest
+  // valid entries whose neighbourhoods lie apart are evaluated side by side (in parallel), then
+  // applied in queue order. An evaluation whose neighbourhood an earlier collapse of the batch
+  // touched (shared vertices or overlapping boxes) is not applied but queued again, so every
+  // applied decision is the one the sequential algorithm would take on the current cage.
+  void drain(int target, int start, SimplifyResult& r)
   {
+    std::vector<Eval> batch(BatchSize);
+    std::vector<Entry> aside;
+    std::vector<std::pair<Vec3, Vec3>> formBoxes, writeBoxes;
+    const double margin = Opt.selfClearance();
     while (AliveVertices > target && !Heap.empty())
     {
-      Entry e = Heap.top();
-      Heap.pop();
-      if (!VAlive[e.V0] || !VAlive[e.V1] || Ver[e.V0] != e.Ver0 || Ver[e.V1] != e.Ver1)
-        continue;
-      if (++sinceProgress >= 512)
+      if (++BatchesSinceProgress >= 16)
       {
-        sinceProgress = 0;
+        BatchesSinceProgress = 0;
         if (Prog && Prog->update(double(start - AliveVertices) / std::max(1, start - target)))
         {
           r.Cancelled = true;
           break;
         }
       }
-      if (!gather(e.V0, e.V1))
+      // form: valid entries in queue order, skipping (for the next batch) those next to a member
+      int n = 0;
+      aside.clear();
+      formBoxes.clear();
+      while (n < BatchSize && !Heap.empty() && aside.size() < 2 * BatchSize)
       {
-        ++Stats.RejectedTopology;
-        block(e.V0, e.V1);
+        const Entry e = Heap.top();
+        Heap.pop();
+        if (!VAlive[e.V0] || !VAlive[e.V1] || Ver[e.V0] != e.Ver0 || Ver[e.V1] != e.Ver1)
+          continue;
+        Vec3 lo = e.Pos, hi = e.Pos;
+        for (int v : { e.V0, e.V1 })
+          for (int f : VT[v])
+            for (int w : T[f])
+            {
+              lo = lo.cwiseMin(P[w]);
+              hi = hi.cwiseMax(P[w]);
+            }
+        lo -= Vec3::Constant(margin);
+        hi += Vec3::Constant(margin);
+        bool near = false;
+        for (const auto& b : formBoxes)
+          near = near || !((b.first.array() > hi.array()).any() || (b.second.array() < lo.array()).any());
+        if (near)
+        {
+          aside.push_back(e);
+          continue;
+        }
+        formBoxes.emplace_back(lo, hi);
+        batch[n++].E = e;
+      }
+      for (const Entry& e : aside)
+        Heap.push(e);
+      if (n == 0)
         continue;
-      }
-      Vec3 pos = e.Pos;
-      const Verdict v = check(pos);
-      if (v != Verdict::Ok)
+
+      // evaluate
+      if (n > 1)
+        tbb::parallel_for(0, n, [&](int i) { evaluate(batch[i], Scratches.local()); });
+      else
+        evaluate(batch[0], Scratches.local());
+
+      // apply, in order
+      ++BatchStamp;
+      writeBoxes.clear();
+      for (int i = 0; i < n && AliveVertices > target; ++i)
       {
-        countReject(v);
-        if (!place(pos, v))
+        Eval& ev = batch[i];
+        if (touched(ev, writeBoxes))
         {
-          block(e.V0, e.V1);
+          Heap.push(ev.E); // evaluated on a neighbourhood that has changed since: again later
           continue;
         }
-        ++Stats.Relocated;
-        const double cost = costAt(e.V0, e.V1, pos);
-        if (!Heap.empty() && cost > Heap.top().Cost)
+        for (const auto& vd : ev.Dist)
+          if (D[vd.first] < 0)
+            D[vd.first] = vd.second;
+        Stats.RejectedInput += ev.RejInput;
+        Stats.RejectedSelf += ev.RejSelf;
+        Stats.RejectedShape += ev.RejShape;
+        if (!ev.Gathered)
         {
-          // no longer the cheapest: queue it with its feasible placement
-          Heap.push({ cost, e.V0, e.V1, Ver[e.V0], Ver[e.V1], pos });
+          ++Stats.RejectedTopology;
+          block(ev.E.V0, ev.E.V1);
           continue;
         }
+        if (!ev.Feasible)
+        {
+          block(ev.E.V0, ev.E.V1);
+          continue;
+        }
+        if (ev.Relocated)
+        {
+          ++Stats.Relocated;
+          if (!Heap.empty() && ev.Cost > Heap.top().Cost)
+          {
+            // no longer the cheapest: queue it with its feasible placement
+            Heap.push({ ev.Cost, ev.C0, ev.C1, Ver[ev.C0], Ver[ev.C1], ev.Pos });
+            continue;
+          }
+        }
+        // what this collapse writes: its vertices and the box of its old and new triangles
+        Vec3 lo = ev.Pos, hi = ev.Pos;
+        for (int v : ev.Verts)
+        {
+          VStamp[v] = BatchStamp;
+          lo = lo.cwiseMin(P[v]);
+          hi = hi.cwiseMax(P[v]);
+        }
+        writeBoxes.emplace_back(lo, hi);
+        collapse(ev);
+        ++Stats.Collapses;
+        if (AliveTriangles * 2 < GridTriangles)
+          rebuildGrid();
       }
-      collapse(pos);
-      ++Stats.Collapses;
-      if (AliveTriangles * 2 < GridTriangles)
-        rebuildGrid();
     }
+  }
+
+  // Did a collapse applied earlier in this batch change what `ev` read?
+  bool touched(const Eval& ev, const std::vector<std::pair<Vec3, Vec3>>& writeBoxes) const
+  {
+    if (writeBoxes.empty())
+      return false;
+    for (int v : ev.Verts)
+      if (VStamp[v] == BatchStamp)
+        return true;
+    if (ev.HasRead)
+      for (const auto& b : writeBoxes)
+        if (!((b.first.array() > ev.ReadHi.array()).any() || (b.second.array() < ev.ReadLo.array()).any()))
+          return true;
+    return false;
+  }
+
+  // Evaluates the collapse of ev.E on the current cage (reads only; any thread).
+  void evaluate(Eval& ev, Scratch& s) const
+  {
+    ev.S = &s;
+    ev.Gathered = ev.Feasible = ev.Relocated = false;
+    ev.HasRead = false;
+    ev.Dist.clear();
+    ev.LastCheckExact = false;
+    ev.RejInput = ev.RejSelf = ev.RejShape = 0;
+    ev.Gathered = gather(ev);
+    if (!ev.Gathered)
+      return;
+    Vec3 pos = ev.E.Pos;
+    const Verdict v = check(pos, ev);
+    if (v != Verdict::Ok)
+    {
+      countReject(v, ev);
+      if (!place(pos, v, ev))
+        return;
+      ev.Relocated = true;
+      ev.Cost = costAt(ev.C0, ev.C1, pos);
+    }
+    ev.Feasible = true;
+    ev.Pos = pos;
   }
 
   // Queues every blocked edge again; false if there is none.
@@ -337,7 +517,7 @@ public:
   // feasible one: the midpoint and the endpoints; the Psi descent from the placement (and, in the
   // thorough passes, from the other starts); in the thorough passes, an outward walk along the
   // one-ring's normal. Returns the cheapest found first in that order.
-  bool place(Vec3& pos, Verdict first)
+  bool place(Vec3& pos, Verdict first, Eval& ev) const
   {
     // the ordinary pass keeps to the Psi descent from the placement when the input is too
     // close: trying alternatives on every rejection of a dense envelope costs more than it gains
@@ -346,20 +526,21 @@ public:
       if (first != Verdict::Input)
         return false;
       Vec3 p = pos;
-      if (!relocate(p))
+      if (!relocate(p, ev))
         return false;
       pos = p;
       return true;
     }
-    const Vec3 starts[4] = { pos, 0.5 * (P[C0] + P[C1]), P[C0], P[C1] };
+    const int c0 = ev.C0, c1 = ev.C1;
+    const Vec3 starts[4] = { pos, 0.5 * (P[c0] + P[c1]), P[c0], P[c1] };
     // the alternatives by increasing cost: the first feasible one is the cheapest
     int order[3] = { 1, 2, 3 };
     double cost[4];
     for (int i = 1; i < 4; ++i)
-      cost[i] = costAt(C0, C1, starts[i]);
+      cost[i] = costAt(c0, c1, starts[i]);
     std::sort(order, order + 3, [&](int a, int b) { return cost[a] < cost[b] || (cost[a] == cost[b] && a < b); });
     for (int i : order)
-      if (check(starts[i]) == Verdict::Ok)
+      if (check(starts[i], ev) == Verdict::Ok)
       {
         pos = starts[i];
         return true;
@@ -367,7 +548,7 @@ public:
     for (int i = 0; i < 4; ++i)
     {
       Vec3 p = starts[i];
-      if (relocate(p))
+      if (relocate(p, ev))
       {
         pos = p;
         return true;
@@ -375,22 +556,22 @@ public:
     }
     // outward walk: the area-weighted normal of the current one-ring of the edge
     Vec3 n = Vec3::Zero();
-    for (int f : Changed)
+    for (int f : ev.Changed)
       n += (P[T[f][1]] - P[T[f][0]]).cross(P[T[f][2]] - P[T[f][0]]);
-    for (int f : Removed)
+    for (int f : ev.Removed)
       n += (P[T[f][1]] - P[T[f][0]]).cross(P[T[f][2]] - P[T[f][0]]);
     if (!(n.norm() > 0))
       return false;
     n.normalize();
-    double reach = (P[C0] - P[C1]).norm();
-    for (int f : Changed)
+    double reach = (P[c0] - P[c1]).norm();
+    for (int f : ev.Changed)
       for (int v : T[f])
-        reach = std::max(reach, (P[v] - P[C0]).norm());
+        reach = std::max(reach, (P[v] - P[c0]).norm());
     for (int i = 0; i < 4; ++i)
       for (double t = Opt.Clearance; t <= reach; t *= 2)
       {
         const Vec3 p = starts[i] + t * n;
-        if (check(p) == Verdict::Ok)
+        if (check(p, ev) == Verdict::Ok)
         {
           pos = p;
           return true;
@@ -401,20 +582,23 @@ public:
 
 private:
   // distance from cage vertex v to the input (exact, or a lower bound when beyond a cap),
-  // computed when first needed after v moved
-  double vertexDistance(int v)
+  // measured when first needed after v moved (kept in ev until the batch applies it)
+  double vertexDistance(int v, Eval& ev) const
   {
-    if (D[v] < 0)
-    {
-      // bounded query: beyond the cap, the cap itself is a valid lower bound and enough to clear
-      // any triangle of the dense and middle stages
-      const double cap = 16.0 * Opt.Clearance;
-      Vec3 c;
-      int tri;
-      double d;
-      D[v] = Input.closestPoint(P[v], cap, c, tri, d) ? d : cap;
-    }
-    return D[v];
+    if (D[v] >= 0)
+      return D[v];
+    for (const auto& vd : ev.Dist)
+      if (vd.first == v)
+        return vd.second;
+    // bounded query: beyond the cap, the cap itself is a valid lower bound and enough to clear
+    // any triangle of the dense and middle stages
+    const double cap = 16.0 * Opt.Clearance;
+    Vec3 c;
+    int tri;
+    double d;
+    const double value = Input.closestPoint(P[v], cap, c, tri, d) ? d : cap;
+    ev.Dist.emplace_back(v, value);
+    return value;
   }
 
   // ---- adjacency ----
@@ -481,50 +665,43 @@ private:
     }
   }
 
-  // ---- the collapse being evaluated (v0 survives, v1 goes) ----
-  int C0 = -1, C1 = -1;
-  std::vector<int> Removed, Changed;
-  std::vector<int> N0, N1, Ring; // scratch
-  struct Sample
+  bool gather(Eval& ev) const
   {
-    bool Near = false; // the input lies within the descent's target distance
-    double D = 0, Xi = 0;
-    Vec3 Dir = Vec3::Zero();
-  };
-  std::vector<std::pair<int, Sample>> SampleCache;
-  unsigned MarkId = 0;
-
-  bool gather(int v0, int v1)
-  {
-    C0 = v0;
-    C1 = v1;
-    Removed.clear();
-    Changed.clear();
+    Scratch& s = *ev.S;
+    const int v0 = ev.E.V0, v1 = ev.E.V1;
+    ev.C0 = v0;
+    ev.C1 = v1;
+    ev.Removed.clear();
+    ev.Changed.clear();
+    neighbours(v0, s.N0);
+    neighbours(v1, s.N1);
+    ev.Verts.assign(s.N0.begin(), s.N0.end());
+    ev.Verts.insert(ev.Verts.end(), s.N1.begin(), s.N1.end());
+    ev.Verts.push_back(v0);
+    ev.Verts.push_back(v1);
     for (int f : VT[v0])
     {
       const Triangle& t = T[f];
       if (t[0] == v1 || t[1] == v1 || t[2] == v1)
-        Removed.push_back(f);
+        ev.Removed.push_back(f);
       else
-        Changed.push_back(f);
+        ev.Changed.push_back(f);
     }
     for (int f : VT[v1])
     {
       const Triangle& t = T[f];
       if (!(t[0] == v0 || t[1] == v0 || t[2] == v0))
-        Changed.push_back(f);
+        ev.Changed.push_back(f);
     }
-    if (Removed.size() != 2)
+    if (ev.Removed.size() != 2)
       return false;
     // link condition: the common neighbours of v0 and v1 are exactly the two opposite vertices
-    neighbours(v0, N0);
-    neighbours(v1, N1);
     std::size_t common = 0;
-    for (std::size_t i = 0, j = 0; i < N0.size() && j < N1.size();)
+    for (std::size_t i = 0, j = 0; i < s.N0.size() && j < s.N1.size();)
     {
-      if (N0[i] < N1[j])
+      if (s.N0[i] < s.N1[j])
         ++i;
-      else if (N1[j] < N0[i])
+      else if (s.N1[j] < s.N0[i])
         ++j;
       else
       {
@@ -536,48 +713,50 @@ private:
     if (common != 2)
       return false;
     // keep at least a tetrahedron per component
-    if (N0.size() + N1.size() <= 6 && AliveVertices <= 4)
+    if (s.N0.size() + s.N1.size() <= 6 && AliveVertices <= 4)
       return false;
-    ++MarkId;
-    if (MarkId == 0)
+    ++s.MarkId;
+    if (s.MarkId == 0)
     {
-      std::fill(Mark.begin(), Mark.end(), 0);
-      MarkId = 1;
+      std::fill(s.Mark.begin(), s.Mark.end(), 0);
+      s.MarkId = 1;
     }
-    for (int f : Removed)
-      Mark[f] = MarkId;
-    for (int f : Changed)
-      Mark[f] = MarkId;
+    for (int f : ev.Removed)
+      s.Mark[f] = s.MarkId;
+    for (int f : ev.Changed)
+      s.Mark[f] = s.MarkId;
     return true;
   }
 
   // new vertex ids and positions of changed triangle f when the collapse puts v0 at p
-  void newTriangle(int f, const Vec3& p, int ids[3], Vec3 pts[3]) const
+  void newTriangle(const Eval& ev, int f, const Vec3& p, int ids[3], Vec3 pts[3]) const
   {
     for (int k = 0; k < 3; ++k)
     {
       int v = T[f][k];
-      if (v == C1)
-        v = C0;
+      if (v == ev.C1)
+        v = ev.C0;
       ids[k] = v;
-      pts[k] = v == C0 ? p : P[v];
+      pts[k] = v == ev.C0 ? p : P[v];
     }
   }
 
-  Verdict check(const Vec3& p)
+  Verdict check(const Vec3& p, Eval& ev) const
   {
-    LastCheckExact = false;
+    Scratch& s = *ev.S;
+    ev.LastCheckExact = false;
     const double delta = Opt.Clearance;
     const double selfDelta = Opt.selfClearance();
-    NewTris.resize(Changed.size());
+    auto& newTris = s.NewTris;
+    newTris.resize(ev.Changed.size());
     // shape first (cheap): no needles, no flips
-    for (std::size_t i = 0; i < Changed.size(); ++i)
+    for (std::size_t i = 0; i < ev.Changed.size(); ++i)
     {
-      auto& nt = NewTris[i];
-      newTriangle(Changed[i], p, nt.Ids, nt.Pts);
+      auto& nt = newTris[i];
+      newTriangle(ev, ev.Changed[i], p, nt.Ids, nt.Pts);
       if (triangleQuality(nt.Pts[0], nt.Pts[1], nt.Pts[2]) < Opt.MinimumTriangleQuality)
         return Verdict::Shape;
-      const Triangle& old = T[Changed[i]];
+      const Triangle& old = T[ev.Changed[i]];
       const Vec3 no = (P[old[1]] - P[old[0]]).cross(P[old[2]] - P[old[0]]);
       nt.N = (nt.Pts[1] - nt.Pts[0]).cross(nt.Pts[2] - nt.Pts[0]);
       nt.C = (nt.Pts[0] + nt.Pts[1] + nt.Pts[2]) / 3.0;
@@ -586,9 +765,9 @@ private:
         return Verdict::Shape;
     }
     // among the new triangles (they all share v0): no folds, no crossings
-    for (std::size_t i = 0; i < NewTris.size() && Opt.EnforceNoSelfIntersection; ++i)
-      for (std::size_t j = i + 1; j < NewTris.size(); ++j)
-        if (trianglesConflict(NewTris[i].Ids, NewTris[i].Pts, NewTris[j].Ids, NewTris[j].Pts, selfDelta, FoldCosine))
+    for (std::size_t i = 0; i < newTris.size() && Opt.EnforceNoSelfIntersection; ++i)
+      for (std::size_t j = i + 1; j < newTris.size(); ++j)
+        if (trianglesConflict(newTris[i].Ids, newTris[i].Pts, newTris[j].Ids, newTris[j].Pts, selfDelta, FoldCosine))
           return Verdict::Self;
     // the input: clearance delta. Early-out (the distance to the input is 1-Lipschitz): every new
     // triangle lies within `reach` of p (its farthest point from p is a corner), so if no input
@@ -604,7 +783,7 @@ private:
       // the other corners' distances are cached per vertex. Triangles the bound does not clear
       // get the exact triangle-input distance through the tree.
       double maxR = 0;
-      for (const auto& nt : NewTris)
+      for (const auto& nt : newTris)
         maxR = std::max(maxR, nt.R);
       const double limit = delta + maxR;
       Vec3 c;
@@ -614,16 +793,16 @@ private:
         dp = limit;
       else
       {
-        LastCheckPos = p;
-        LastCheckDistance = dp;
-        LastCheckExact = true;
+        ev.LastCheckPos = p;
+        ev.LastCheckDistance = dp;
+        ev.LastCheckExact = true;
       }
-      for (const auto& nt : NewTris)
+      for (const auto& nt : newTris)
       {
         double lo = dp;
         for (int k = 0; k < 3 && lo - nt.R > delta * (1 + 1e-9); ++k)
-          if (nt.Ids[k] != C0)
-            lo = std::min(lo, vertexDistance(nt.Ids[k]));
+          if (nt.Ids[k] != ev.C0)
+            lo = std::min(lo, vertexDistance(nt.Ids[k], ev));
         if (lo - nt.R > delta * (1 + 1e-9))
           continue;
         if (Input.anyCloserThan(nt.Pts, delta))
@@ -635,7 +814,7 @@ private:
     // the rest of the cage: one grid query for the whole new one-ring, then per pair a box test,
     // a bounding-sphere test for disjoint triangles, and the exact conflict test
     Vec3 ringLo = Vec3::Constant(std::numeric_limits<double>::infinity()), ringHi = -ringLo;
-    for (const auto& nt : NewTris)
+    for (const auto& nt : newTris)
       for (const Vec3& q : nt.Pts)
       {
         ringLo = ringLo.cwiseMin(q);
@@ -643,12 +822,29 @@ private:
       }
     ringLo -= Vec3::Constant(selfDelta);
     ringHi += Vec3::Constant(selfDelta);
-    Candidates.clear();
-    ++QueryId;
+    if (ev.HasRead)
+    {
+      ev.ReadLo = ev.ReadLo.cwiseMin(ringLo);
+      ev.ReadHi = ev.ReadHi.cwiseMax(ringHi);
+    }
+    else
+    {
+      ev.ReadLo = ringLo;
+      ev.ReadHi = ringHi;
+      ev.HasRead = true;
+    }
+    auto& candidates = s.Candidates;
+    candidates.clear();
+    ++s.QueryId;
+    if (s.QueryId == 0)
+    {
+      std::fill(s.Seen.begin(), s.Seen.end(), 0);
+      s.QueryId = 1;
+    }
     Grid.query(ringLo, ringHi, [&](int f) {
-      if (!TAlive[f] || Mark[f] == MarkId || Seen[f] == QueryId)
+      if (!TAlive[f] || s.Mark[f] == s.MarkId || s.Seen[f] == s.QueryId)
         return;
-      Seen[f] = QueryId;
+      s.Seen[f] = s.QueryId;
       Candidate c;
       c.F = f;
       for (int k = 0; k < 3; ++k)
@@ -662,13 +858,13 @@ private:
         return;
       c.C = (c.Pts[0] + c.Pts[1] + c.Pts[2]) / 3.0;
       c.R = std::max({ (c.Pts[0] - c.C).norm(), (c.Pts[1] - c.C).norm(), (c.Pts[2] - c.C).norm() });
-      Candidates.push_back(c);
+      candidates.push_back(c);
     });
-    for (const auto& nt : NewTris)
+    for (const auto& nt : newTris)
     {
       const Vec3 lo = nt.Pts[0].cwiseMin(nt.Pts[1]).cwiseMin(nt.Pts[2]) - Vec3::Constant(selfDelta);
       const Vec3 hi = nt.Pts[0].cwiseMax(nt.Pts[1]).cwiseMax(nt.Pts[2]) + Vec3::Constant(selfDelta);
-      for (const Candidate& c : Candidates)
+      for (const Candidate& c : candidates)
       {
         if ((c.Lo.array() > hi.array()).any() || (c.Hi.array() < lo.array()).any())
           continue;
@@ -744,8 +940,9 @@ private:
   // Gradient descent on Psi (eq. 5-6): move the placement so that the new one-ring moves away from
   // the input where it is closer than the target (2 delta), sampling each new triangle where p
   // weighs: at p, at the midpoints of its edges at p and at its centroid (weight = p's share).
-  bool relocate(Vec3& p)
+  bool relocate(Vec3& p, Eval& ev) const
   {
+    auto& sampleCache = ev.S->SampleCache;
     const double target = 2.0 * Opt.Clearance;
     for (int it = 0;; ++it)
     {
@@ -754,15 +951,15 @@ private:
       double nearest = target; // unsigned: a sample nearer than delta dooms check()
       // the corner p and the midpoints of the edges at p are shared by neighbouring triangles:
       // each is measured once per step (key: -1 for p, the other end's id for a midpoint)
-      SampleCache.clear();
-      for (int f : Changed)
+      sampleCache.clear();
+      for (int f : ev.Changed)
       {
         int ids[3];
         Vec3 pts[3];
-        newTriangle(f, p, ids, pts);
+        newTriangle(ev, f, p, ids, pts);
         const double area = 0.5 * (pts[1] - pts[0]).cross(pts[2] - pts[0]).norm();
         int kp = 0;
-        while (ids[kp] != C0)
+        while (ids[kp] != ev.C0)
           ++kp;
         for (int s = 0; s < 4; ++s)
         {
@@ -773,7 +970,7 @@ private:
           Sample smp;
           bool cached = false;
           if (s < 3)
-            for (const auto& kv : SampleCache)
+            for (const auto& kv : sampleCache)
               if (kv.first == key)
               {
                 smp = kv.second;
@@ -801,7 +998,7 @@ private:
               }
             }
             if (s < 3)
-              SampleCache.emplace_back(key, smp);
+              sampleCache.emplace_back(key, smp);
           }
           if (!smp.Near)
             continue; // comfortably clear
@@ -811,7 +1008,7 @@ private:
         }
       }
       // the placement reached by the previous step: checked unless a sample already fails it
-      if (it > 0 && nearest >= Opt.Clearance && check(p) == Verdict::Ok)
+      if (it > 0 && nearest >= Opt.Clearance && check(p, ev) == Verdict::Ok)
         return true;
       if (it == Opt.PlacementIterations)
         return false;
@@ -822,14 +1019,14 @@ private:
     }
   }
 
-  void countReject(Verdict v)
+  static void countReject(Verdict v, Eval& ev)
   {
     if (v == Verdict::Input)
-      ++Stats.RejectedInput;
+      ++ev.RejInput;
     else if (v == Verdict::Self)
-      ++Stats.RejectedSelf;
+      ++ev.RejSelf;
     else if (v == Verdict::Shape)
-      ++Stats.RejectedShape;
+      ++ev.RejShape;
   }
 
   void box(int f, Vec3& lo, Vec3& hi) const
@@ -838,10 +1035,12 @@ private:
     hi = P[T[f][0]].cwiseMax(P[T[f][1]]).cwiseMax(P[T[f][2]]);
   }
 
-  void collapse(const Vec3& p)
+  void collapse(const Eval& ev)
   {
+    const int c0 = ev.C0, c1 = ev.C1;
+    const Vec3& p = ev.Pos;
     Vec3 lo, hi;
-    for (int f : Removed)
+    for (int f : ev.Removed)
     {
       box(f, lo, hi);
       Grid.remove(f, lo, hi);
@@ -853,47 +1052,47 @@ private:
         l.erase(std::remove(l.begin(), l.end(), f), l.end());
       }
     }
-    for (int f : Changed)
+    for (int f : ev.Changed)
     {
       box(f, lo, hi);
       Grid.remove(f, lo, hi);
     }
-    for (int f : VT[C1])
+    for (int f : VT[c1])
     {
       for (int& v : T[f])
-        if (v == C1)
-          v = C0;
-      VT[C0].push_back(f);
+        if (v == c1)
+          v = c0;
+      VT[c0].push_back(f);
     }
-    VT[C1].clear();
-    P[C0] = p;
-    Q[C0] += Q[C1];
-    VAlive[C1] = 0;
+    VT[c1].clear();
+    P[c0] = p;
+    Q[c0] += Q[c1];
+    VAlive[c1] = 0;
     --AliveVertices;
-    ++Ver[C0];
-    ++Ver[C1];
-    for (int f : Changed)
+    ++Ver[c0];
+    ++Ver[c1];
+    for (int f : ev.Changed)
     {
       box(f, lo, hi);
       Grid.insert(f, lo, hi);
     }
-    D[C0] = LastCheckExact && LastCheckPos == p ? LastCheckDistance : -1.0;
-    neighbours(C0, Ring);
+    D[c0] = ev.LastCheckExact && ev.LastCheckPos == p ? ev.LastCheckDistance : -1.0;
+    neighbours(c0, Ring);
     const std::vector<int>& ring = Ring;
-    for (int v : { C0, C1 })
+    for (int v : { c0, c1 })
     {
       for (int n : BlockedAt[v])
         Blocked.erase(edgeKey(v, n));
       BlockedAt[v].clear();
     }
     for (int n : ring)
-      pushEdge(std::min(C0, n), std::max(C0, n));
+      pushEdge(std::min(c0, n), std::max(c0, n));
     // edges around the ring saw their neighbourhood change: retry the blocked ones (stale
     // partners, already collapsed or re-queued, are filtered when popped)
     for (int r : ring)
     {
       for (int n : BlockedAt[r])
-        if (Blocked.erase(edgeKey(r, n)) && n != C0 && VAlive[n])
+        if (Blocked.erase(edgeKey(r, n)) && n != c0 && VAlive[n])
           pushEdge(std::min(r, n), std::max(r, n));
       BlockedAt[r].clear();
     }
@@ -915,8 +1114,6 @@ private:
         Grid.insert(static_cast<int>(f), lo, hi);
       }
     GridTriangles = AliveTriangles;
-    Seen.assign(T.size(), 0);
-    QueryId = 0;
   }
 
   TriangleMesh compact() const
@@ -935,42 +1132,22 @@ private:
     return m;
   }
 
-  struct NewTri
-  {
-    int Ids[3];
-    Vec3 Pts[3];
-    Vec3 N;
-    Vec3 C;   // centroid
-    double R; // bounding radius about C
-  };
-
   const TriangleTree& Input;
   SimplifyOptions Opt;
   const SimplifyOptions Original;
   Progress* Prog;
+  tbb::enumerable_thread_specific<Scratch> Scratches;
   std::vector<Vec3> P;
   std::vector<Triangle> T;
   std::vector<char> VAlive, TAlive;
   std::vector<std::vector<int>> VT;
   std::vector<Quadric> Q;
   std::vector<double> D; // distance (or lower bound) to the input per vertex, < 0 = not known
-  Vec3 LastCheckPos = Vec3::Zero();
-  double LastCheckDistance = -1;
-  bool LastCheckExact = false; // check() measured the exact distance of LastCheckPos
   std::vector<unsigned> Ver;
-  std::vector<unsigned> Mark;
-  std::vector<unsigned> Seen;
-  unsigned QueryId = 0;
-  std::vector<NewTri> NewTris;
-  struct Candidate
-  {
-    int F;
-    int Ids[3];
-    Vec3 Pts[3];
-    Vec3 Lo, Hi, C;
-    double R;
-  };
-  std::vector<Candidate> Candidates;
+  std::vector<unsigned> VStamp; // == BatchStamp: written by a collapse of the current batch
+  unsigned BatchStamp = 0;
+  int BatchesSinceProgress = 0;
+  std::vector<int> Ring; // scratch of collapse()
   int AliveVertices = 0, AliveTriangles = 0, GridTriangles = 0;
   CageGrid Grid;
   std::priority_queue<Entry> Heap;

@@ -62,8 +62,10 @@ struct SimplifyResult
 };
 
 /// Simplifies `envelope` (closed, outward, unit units, at least `Clearance` from the input) down
-/// to options.TargetVertices vertices. `inputTree` indexes the normalized input. Deterministic:
-/// one sequential collapse order, independent of the thread count.
+/// to options.TargetVertices vertices. `inputTree` indexes the normalized input. Candidate
+/// collapses are evaluated in batches of well-separated edges on all threads and applied in queue
+/// order; an evaluation whose neighbourhood an earlier collapse changed is repeated later.
+/// Deterministic: the batches do not depend on the thread count, nor does the cage.
 SimplifyResult simplifyEnvelope(const TriangleMesh& envelope, const TriangleTree& inputTree,
   const SimplifyOptions& options, Progress* progress = nullptr);
 
