@@ -126,7 +126,8 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
   }
   else
   {
-    const TriangleTree tree(unit);
+    const std::shared_ptr<const TriangleTree> ownTree = env.InputTree ? nullptr : std::make_shared<TriangleTree>(unit);
+    const TriangleTree& tree = env.InputTree ? *env.InputTree : *ownTree;
     SimplifyOptions so = options.Simplify;
     so.TargetVertices = options.TargetNumberOfVertices;
     so.Clearance = options.Envelope.clearance();
@@ -143,7 +144,7 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
     std::vector<double> dist;
     std::string why;
     double clearance = 0.0;
-    const bool ok = verifyEnclosure(unit, result.Simplification.Cage, so.Clearance, clearance, why, &dist, nullptr);
+    const bool ok = verifyEnclosure(unit, result.Simplification.Cage, so.Clearance, clearance, why, &dist, nullptr, true, &tree);
     result.CageVerificationSeconds = seconds(t1);
     if (!ok)
     {

@@ -10,6 +10,7 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
+#include <tbb/task_group.h>
 
 #include <algorithm>
 #include <cstdio>
@@ -167,14 +168,13 @@ void markSelfIntersecting(const TriangleMesh& surface, std::vector<char>& bad)
 
 /// Where a failed surface is wrong: points on every triangle (sampled about one voxel apart)
 /// that crosses another triangle or comes closer than `clearance` to the input.
-std::vector<Vec3> defectLocations(const TriangleMesh& input, const TriangleMesh& surface, double clearance, double voxel)
+std::vector<Vec3> defectLocations(const TriangleTree& tree, const TriangleMesh& surface, double clearance, double voxel)
 {
   const std::size_t nf = surface.Triangles.size();
   std::vector<char> bad(nf, 0);
   markSelfIntersecting(surface, bad);
   // clearance
   {
-    const TriangleTree tree(input);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t f = r.begin(); f != r.end(); ++f)
       {
@@ -364,7 +364,7 @@ long long countSelfIntersections(const TriangleMesh& mesh, Progress* progress)
 
 bool verifyEnclosure(const TriangleMesh& input, const TriangleMesh& cage, double clearance,
   double& measuredClearance, std::string& why, std::vector<double>* pointDistances, Progress* progress,
-  bool exactMinimum)
+  bool exactMinimum, const TriangleTree* inputTree)
 {
   measuredClearance = 0.0;
   why.clear();
@@ -380,7 +380,13 @@ bool verifyEnclosure(const TriangleMesh& input, const TriangleMesh& cage, double
     why = "the surface intersects itself (" + std::to_string(selfIntersections) + " triangle pairs)";
     return false;
   }
-  const TriangleTree index(input);
+  std::unique_ptr<TriangleTree> ownTree;
+  if (!inputTree)
+  {
+    ownTree = std::make_unique<TriangleTree>(input);
+    inputTree = ownTree.get();
+  }
+  const TriangleTree& index = *inputTree;
 
   // 1. exact distance of every cage point to the input
   const std::size_t nv = cage.Points.size();
@@ -550,6 +556,34 @@ EnvelopeResult buildEnvelope(
     result.Message = "invalid parameters: need IsoValue > 0, VoxelSize > 0 and 0 < MinimumClearance < IsoValue";
     return result;
   }
+  // The input's tree for the verification is built meanwhile (on another thread when there is
+  // one): the active points and the distance field come first.
+  auto inputTree = std::make_shared<TriangleTree>();
+  tbb::task_group treeTask;
+  treeTask.run([&unitInput, inputTree] { inputTree->build(unitInput); });
+  struct WaitFor
+  {
+    tbb::task_group& Group;
+    ~WaitFor()
+    {
+      try
+      {
+        Group.wait();
+      }
+      catch (...) // out of memory in the build: nothing to do on the way out
+      {
+      }
+    }
+  } waitForTree{ treeTask }; // every return path waits for it
+  bool treeReady = false;
+  auto tree = [&]() -> const TriangleTree& {
+    if (!treeReady)
+    {
+      treeTask.wait();
+      treeReady = true;
+    }
+    return *inputTree;
+  };
   {
     std::vector<int> comp;
     result.InputComponents = triangleComponents(unitInput, comp);
@@ -616,7 +650,7 @@ EnvelopeResult buildEnvelope(
       double clearance = 0.0;
       std::vector<double> distances;
       const bool ok = verifyEnclosure(unitInput, envelope, delta, clearance, why, &distances, progress,
-        options.ExactEnvelopeClearance);
+        options.ExactEnvelopeClearance, &tree());
       ++attempt;
       if (ok)
       {
@@ -640,7 +674,7 @@ EnvelopeResult buildEnvelope(
         }
         if (adaptivity > 0.0)
         {
-          repairNear = defectLocations(unitInput, envelope, delta, h);
+          repairNear = defectLocations(tree(), envelope, delta, h);
         }
       }
       result.VerificationSeconds += seconds(t1);
@@ -692,6 +726,8 @@ EnvelopeResult buildEnvelope(
       result.EnclosureVerified = true;
       result.State = Status::Ok;
       result.Message.clear();
+      tree();
+      result.InputTree = inputTree;
       return result;
     }
   }

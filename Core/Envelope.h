@@ -5,6 +5,7 @@
 #include "Mesh.h"
 
 #include <array>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -12,6 +13,7 @@ namespace sdfcage
 {
 
 class Progress;
+class TriangleTree;
 
 /// All lengths in unit-sphere units (the input is normalized first).
 struct EnvelopeOptions
@@ -104,6 +106,9 @@ struct EnvelopeResult
   /// closer than the parameters can separate were fused, or handles closed): the envelope is
   /// still verified, but the cage will not have the input's topology.
   std::string TopologyWarning;
+  /// The bounding-volume tree of the unit input the verification used (built while the distance
+  /// field is computed), for the later stages to reuse.
+  std::shared_ptr<const TriangleTree> InputTree;
 };
 
 /// Builds and verifies the envelope of a validated, normalized mesh (unit-sphere units).
@@ -120,8 +125,9 @@ long long countSelfIntersections(const TriangleMesh& mesh, Progress* progress = 
 /// component inside (winding number). Returns the measured exact minimum clearance in
 /// `measuredClearance` (with exactMinimum; otherwise a certified lower bound >= clearance, much
 /// cheaper on dense surfaces) and per-cage-point exact distances in `pointDistances` (if non-null).
+/// `inputTree`, if given, must index `input` (saves building it).
 bool verifyEnclosure(const TriangleMesh& input, const TriangleMesh& cage, double clearance,
   double& measuredClearance, std::string& why, std::vector<double>* pointDistances = nullptr,
-  Progress* progress = nullptr, bool exactMinimum = true);
+  Progress* progress = nullptr, bool exactMinimum = true, const TriangleTree* inputTree = nullptr);
 
 } // namespace sdfcage

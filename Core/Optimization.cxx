@@ -1034,7 +1034,7 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
   std::string why;
   double measured = 0.0;
   const auto tv = std::chrono::steady_clock::now();
-  if (!verifyEnclosure(input, cage, std::numeric_limits<double>::min(), measured, why, nullptr, nullptr, true))
+  if (!verifyEnclosure(input, cage, std::numeric_limits<double>::min(), measured, why, nullptr, nullptr, true, &inputTree))
   {
     r.State = Status::InvalidInput;
     r.Message = "the given cage does not enclose the input without self-intersection: " + why;
@@ -1091,7 +1091,7 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
   TriangleMesh result = opt.mesh();
   double clearance = 0.0;
   std::vector<double> dist;
-  if (verifyEnclosure(input, result, delta, clearance, why, &dist, nullptr, true))
+  if (verifyEnclosure(input, result, delta, clearance, why, &dist, nullptr, true, &inputTree))
   {
     r.Cage = std::move(result);
     r.MinimumClearance = clearance;
@@ -1103,7 +1103,7 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
     r.Reverted = true;
     r.Message = "the optimized cage failed verification (" + why + "); the given cage is returned unchanged";
     r.Cage = cage;
-    verifyEnclosure(input, cage, std::numeric_limits<double>::min(), clearance, why, &dist, nullptr, true);
+    verifyEnclosure(input, cage, std::numeric_limits<double>::min(), clearance, why, &dist, nullptr, true, &inputTree);
     r.MinimumClearance = clearance;
     r.DistanceToInput = std::move(dist);
   }

@@ -7,8 +7,26 @@
 #include <limits>
 #include <numeric>
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_invoke.h>
+
 namespace sdfcage
 {
+
+namespace
+{
+// Nodes of the subtree over `count` triangles (leaves of at most 4, halves by count).
+int subtreeNodes(int count, int depth)
+{
+  if (count <= 4 || depth > 60)
+  {
+    return 1;
+  }
+  const int half = count / 2;
+  return 1 + subtreeNodes(half, depth + 1) + subtreeNodes(count - half, depth + 1);
+}
+} // namespace
 
 void TriangleTree::build(const TriangleMesh& mesh)
 {
@@ -20,71 +38,93 @@ void TriangleTree::build(const TriangleMesh& mesh)
   {
     return;
   }
-  Tri.resize(n);
+  std::vector<Tri3> tri(n);
   Normals.resize(n);
   std::vector<Vec3> centroids(n);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t f = r.begin(); f != r.end(); ++f)
+    {
+      const Triangle& t = mesh.Triangles[f];
+      for (int k = 0; k < 3; ++k)
+      {
+        tri[f].P[k] = mesh.Points[t[k]];
+      }
+      tri[f].Id = static_cast<int>(f);
+      const Vec3 nrm = (tri[f].P[1] - tri[f].P[0]).cross(tri[f].P[2] - tri[f].P[0]);
+      Normals[f] = nrm.norm() > 0 ? Vec3(nrm.normalized()) : Vec3(Vec3::Zero());
+      centroids[f] = (tri[f].P[0] + tri[f].P[1] + tri[f].P[2]) / 3.0;
+    }
+  });
+  // The node layout is fixed in advance (pre-order, sizes known from the counts), so subtrees
+  // are built in parallel into their own ranges and the tree does not depend on the threads.
+  Nodes.resize(static_cast<std::size_t>(subtreeNodes(static_cast<int>(n), 0)));
+  std::vector<BuildItem> items(n);
   for (std::size_t f = 0; f < n; ++f)
   {
-    const Triangle& t = mesh.Triangles[f];
-    for (int k = 0; k < 3; ++k)
-    {
-      Tri[f].P[k] = mesh.Points[t[k]];
-    }
-    Tri[f].Id = static_cast<int>(f);
-    const Vec3 nrm = (Tri[f].P[1] - Tri[f].P[0]).cross(Tri[f].P[2] - Tri[f].P[0]);
-    Normals[f] = nrm.norm() > 0 ? Vec3(nrm.normalized()) : Vec3(Vec3::Zero());
-    centroids[f] = (Tri[f].P[0] + Tri[f].P[1] + Tri[f].P[2]) / 3.0;
+    items[f] = { centroids[f], static_cast<int>(f) };
   }
-  Nodes.reserve(2 * n / 2 + 1);
-  buildNode(0, static_cast<int>(n), centroids, 0);
+  buildNode(0, 0, static_cast<int>(n), items, tri, 0);
+  Tri.resize(n);
+  for (std::size_t i = 0; i < n; ++i)
+  {
+    Tri[i] = tri[items[i].Id];
+  }
 }
 
-int TriangleTree::buildNode(int start, int count, std::vector<Vec3>& centroids, int depth)
+void TriangleTree::buildNode(int index, int start, int count, std::vector<BuildItem>& items,
+  const std::vector<Tri3>& tri, int depth)
 {
-  const int index = static_cast<int>(Nodes.size());
-  Nodes.emplace_back();
-  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-  Vec3 clo = lo, chi = hi;
-  for (int i = start; i < start + count; ++i)
-  {
-    for (const Vec3& p : Tri[i].P)
-    {
-      lo = lo.cwiseMin(p);
-      hi = hi.cwiseMax(p);
-    }
-    clo = clo.cwiseMin(centroids[i]);
-    chi = chi.cwiseMax(centroids[i]);
-  }
-  Nodes[index].Lo = lo;
-  Nodes[index].Hi = hi;
+  Node& node = Nodes[index];
   if (count <= 4 || depth > 60)
   {
-    Nodes[index].Start = start;
-    Nodes[index].Count = count;
-    return index;
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (int i = start; i < start + count; ++i)
+    {
+      for (const Vec3& p : tri[items[i].Id].P)
+      {
+        lo = lo.cwiseMin(p);
+        hi = hi.cwiseMax(p);
+      }
+    }
+    node.Lo = lo;
+    node.Hi = hi;
+    node.Start = start;
+    node.Count = count;
+    return;
+  }
+  Vec3 clo = Vec3::Constant(std::numeric_limits<double>::infinity()), chi = -clo;
+  for (int i = start; i < start + count; ++i)
+  {
+    clo = clo.cwiseMin(items[i].C);
+    chi = chi.cwiseMax(items[i].C);
   }
   int axis = 0;
   (chi - clo).maxCoeff(&axis);
-  const int mid = start + count / 2;
-  // partial sort of triangles and centroids together by the centroid coordinate
-  std::vector<int> order(count);
-  std::iota(order.begin(), order.end(), 0);
-  std::nth_element(order.begin(), order.begin() + (mid - start), order.end(),
-    [&](int a, int b) { return centroids[start + a][axis] < centroids[start + b][axis]; });
-  std::vector<Tri3> tri(count);
-  std::vector<Vec3> cen(count);
-  for (int i = 0; i < count; ++i)
+  const int half = count / 2;
+  // median split by the centroid coordinate (ties by id, so the split is deterministic)
+  std::nth_element(items.begin() + start, items.begin() + start + half, items.begin() + start + count,
+    [axis](const BuildItem& a, const BuildItem& b) {
+      const double ca = a.C[axis], cb = b.C[axis];
+      return ca < cb || (ca == cb && a.Id < b.Id);
+    });
+  const int left = index + 1;
+  const int right = left + subtreeNodes(half, depth + 1);
+  node.Left = left;
+  node.Right = right;
+  auto buildLeft = [&] { buildNode(left, start, half, items, tri, depth + 1); };
+  auto buildRight = [&] { buildNode(right, start + half, count - half, items, tri, depth + 1); };
+  if (count > 8192)
   {
-    tri[i] = Tri[start + order[i]];
-    cen[i] = centroids[start + order[i]];
+    tbb::parallel_invoke(buildLeft, buildRight);
   }
-  std::copy(tri.begin(), tri.end(), Tri.begin() + start);
-  std::copy(cen.begin(), cen.end(), centroids.begin() + start);
-  const int left = buildNode(start, mid - start, centroids, depth + 1);
-  const int right = buildNode(mid, start + count - mid, centroids, depth + 1);
-  Nodes[index].Left = left;
-  Nodes[index].Right = right;
-  return index;
+  else
+  {
+    buildLeft();
+    buildRight();
+  }
+  // the box from the children's
+  Nodes[index].Lo = Nodes[left].Lo.cwiseMin(Nodes[right].Lo);
+  Nodes[index].Hi = Nodes[left].Hi.cwiseMax(Nodes[right].Hi);
 }
 
 namespace

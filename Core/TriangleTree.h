@@ -51,7 +51,13 @@ private:
     Vec3 P[3];
     int Id;
   };
-  int buildNode(int start, int count, std::vector<Vec3>& centroids, int depth);
+  struct BuildItem
+  {
+    Vec3 C; // centroid
+    int Id;
+  };
+  void buildNode(int index, int start, int count, std::vector<BuildItem>& items, const std::vector<Tri3>& tri,
+    int depth);
   double triangleQuery(const Vec3 t[3], double limit, bool stopAtFirst, std::vector<int>* within = nullptr) const;
   std::vector<Node> Nodes;
   std::vector<Tri3> Tri;

@@ -1,7 +1,7 @@
 """SDFCage benchmark: cages of many meshes at several sizes, judged by the quality filter.
 
     /usr/bin/python3 Testing/Benchmarks/cage_benchmark.py [MESH|FOLDER ...] [--builtin]
-        [--vertices 200 500 1000] [--out benchmark] [--sdfcage build/bin/sdfcage]
+        [--vertices 200 500 1000] [--optimize none mips] [--out benchmark] [--sdfcage build/bin/sdfcage]
         [--timeout SECONDS] [--no-plots] [--no-gallery] [--replot]
 
 Default: every mesh of ../shared/data (next to the source tree). For each mesh and each vertex
@@ -18,9 +18,9 @@ count it runs `sdfcage MESH -n N` (its own process: peak memory is per run), the
   run the script under `xvfb-run -a`).
 
 --replot redraws the plots and the gallery from an earlier run's output folder (results.csv and
-cages/) without computing anything. Meshes the program rejects (open, non-manifold, ...) appear with their exit code and status.
-Optimization (paper section 3.3) is not part of this build, so there is no "with optimization"
-column yet.
+cages/) without computing anything. Meshes the program rejects (open, non-manifold, ...) appear
+with their exit code and status. `--optimize none mips` (the default) runs every cage without and
+with the optimization (paper section 3.3); the table has one row per variant.
 """
 import argparse
 import csv
