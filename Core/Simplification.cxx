@@ -286,6 +286,14 @@ public:
     const auto t0 = std::chrono::steady_clock::now();
     const int start = AliveVertices;
     const int target = std::max(4, Opt.TargetVertices);
+    {
+      // the edge of an equilateral triangle of the target's mean area (about 2 target triangles)
+      double area = 0;
+      for (const Triangle& t : T)
+        area += 0.5 * (P[t[1]] - P[t[0]]).cross(P[t[2]] - P[t[0]]).norm();
+      const double edge = std::sqrt(4.0 / std::sqrt(3.0) * area / (2.0 * target));
+      PlacementReach = std::max(16.0 * Opt.Clearance, edge);
+    }
     for (std::size_t v = 0; v < P.size(); ++v)
       for (int n : neighbours(static_cast<int>(v)))
         if (static_cast<int>(v) < n)
@@ -319,7 +327,7 @@ public:
     if (!r.ReachedTarget)
       r.StopReason = r.Cancelled ? "cancelled"
                                  : "no remaining collapse keeps the clearance, self-intersection, "
-                                   "topology and shape constraints";
+                                   "topology, shape and placement-distance constraints";
     r.Cage = compact();
     r.Seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return r;
@@ -540,7 +548,7 @@ public:
       cost[i] = costAt(c0, c1, starts[i]);
     std::sort(order, order + 3, [&](int a, int b) { return cost[a] < cost[b] || (cost[a] == cost[b] && a < b); });
     for (int i : order)
-      if (check(starts[i], ev) == Verdict::Ok)
+      if (check(starts[i], ev) == Verdict::Ok && withinReach(starts[i]))
       {
         pos = starts[i];
         return true;
@@ -548,7 +556,7 @@ public:
     for (int i = 0; i < 4; ++i)
     {
       Vec3 p = starts[i];
-      if (relocate(p, ev))
+      if (relocate(p, ev) && withinReach(p))
       {
         pos = p;
         return true;
@@ -571,13 +579,24 @@ public:
       for (double t = Opt.Clearance; t <= reach; t *= 2)
       {
         const Vec3 p = starts[i] + t * n;
-        if (check(p, ev) == Verdict::Ok)
+        if (check(p, ev) == Verdict::Ok && withinReach(p))
         {
           pos = p;
           return true;
         }
       }
     return false;
+  }
+
+  // The thorough passes place a vertex no farther from the input than PlacementReach: without a
+  // bound, repeated outward walks on a stubborn region (dragon_quartet at 200 vertices) inflated
+  // the cage to 0.67 of the input's diagonal from it.
+  bool withinReach(const Vec3& p) const
+  {
+    Vec3 c;
+    int tri;
+    double d;
+    return Input.closestPoint(p, PlacementReach, c, tri, d);
   }
 
 private:
@@ -1156,6 +1175,7 @@ private:
   SimplifyResult Stats;
   int Pass = 0;
   int Retries = 0;
+  double PlacementReach = std::numeric_limits<double>::infinity();
   static constexpr int MaxRetries = 16;
 };
 

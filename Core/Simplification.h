@@ -30,7 +30,9 @@ struct SimplifyOptions
   /// A new triangle's normal must stay within this angle of the triangle it replaces: cos = 0.2
   /// (about 78 degrees) forbids flips and near-flips. When no collapse is left above the target,
   /// a last pass relaxes this bound to min(this, 0) and the needle bound to half (folds,
-  /// crossings and clearances stay checked exactly).
+  /// crossings and clearances stay checked exactly). Those late passes place a vertex no
+  /// farther from the input than max(16 Clearance, the edge of an equilateral triangle of the
+  /// target's mean area), so a stubborn region cannot inflate the cage.
   double MinimumNormalCosine = 0.2;
   /// Gradient steps on Psi (eq. 5-6) to move an infeasible placement into the feasible region.
   /// An infeasible placement is first replaced by the edge's midpoint or an endpoint when one of
