@@ -13,6 +13,7 @@
 #include <tbb/task_group.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <atomic>
@@ -21,6 +22,7 @@
 #include <limits>
 #include <memory>
 #include <sstream>
+#include <unordered_map>
 
 namespace sdfcage
 {
@@ -131,8 +133,9 @@ TriangleMesh outerBoundary(const TriangleMesh& surface, int& removed)
 }
 
 
-/// Flags every triangle of `surface` that crosses another one (beyond shared vertices/edges).
-void markSelfIntersecting(const TriangleMesh& surface, std::vector<char>& bad)
+/// Flags every triangle of `surface` that crosses another one (beyond shared vertices/edges);
+/// with `only`, just the triangles it selects are tested (against all the others).
+void markSelfIntersecting(const TriangleMesh& surface, std::vector<char>& bad, const std::vector<char>* only = nullptr)
 {
   const std::size_t nf = surface.Triangles.size();
   bad.resize(nf, 0);
@@ -144,6 +147,10 @@ void markSelfIntersecting(const TriangleMesh& surface, std::vector<char>& bad)
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t f = r.begin(); f != r.end(); ++f)
     {
+      if (only && !(*only)[f])
+      {
+        continue;
+      }
       const Triangle& t = surface.Triangles[f];
       const int ia[3] = { t[0], t[1], t[2] };
       const Vec3 pa[3] = { surface.Points[t[0]], surface.Points[t[1]], surface.Points[t[2]] };
@@ -226,6 +233,43 @@ std::size_t projectOntoAmplifiedOffset(
   std::vector<double> offset; // distance to the input after the projection
   std::vector<Vec3> original = envelope.Points; // where the grid put them (midpoints: of the chord)
   std::atomic<std::size_t> moved{ 0 };
+  // phi - 1 <= 1e-3 (alpha - 1), below which nothing moves, once d^ >= sqrt(ln 1000) / beta. As
+  // d^ = g_A(P(x)) + d(x), with g_A at a surface point at least its distance to the active
+  // points less one edge of the refined surface, a vertex farther than that plus the longest
+  // edge from every active point stays: a hashed grid of the active points answers it.
+  double longestEdge = 0.0;
+  for (const Triangle& t : amp.Surface.Triangles)
+    for (int k = 0; k < 3; ++k)
+      longestEdge = std::max(longestEdge, (amp.Surface.Points[t[k]] - amp.Surface.Points[t[(k + 1) % 3]]).norm());
+  const double reach = std::sqrt(std::log(1000.0)) / amp.Beta + longestEdge;
+  std::unordered_map<std::int64_t, std::vector<Vec3>> activeCells;
+  auto cellKey = [reach](std::int64_t i, std::int64_t j, std::int64_t k) {
+    return ((k & 0x1FFFFF) << 42) | ((j & 0x1FFFFF) << 21) | (i & 0x1FFFFF);
+  };
+  auto cellOf = [reach](double x) { return static_cast<std::int64_t>(std::floor(x / reach)); };
+  for (std::size_t i = 0; i < amp.Surface.Points.size() && i < amp.Active.size(); ++i)
+  {
+    if (amp.Active[i])
+    {
+      const Vec3& a = amp.Surface.Points[i];
+      activeCells[cellKey(cellOf(a.x()), cellOf(a.y()), cellOf(a.z()))].push_back(a);
+    }
+  }
+  auto nearActive = [&](const Vec3& x) {
+    const std::int64_t ci = cellOf(x.x()), cj = cellOf(x.y()), ck = cellOf(x.z());
+    for (std::int64_t k = ck - 1; k <= ck + 1; ++k)
+      for (std::int64_t j = cj - 1; j <= cj + 1; ++j)
+        for (std::int64_t i = ci - 1; i <= ci + 1; ++i)
+        {
+          const auto it = activeCells.find(cellKey(i, j, k));
+          if (it == activeCells.end())
+            continue;
+          for (const Vec3& a : it->second)
+            if ((a - x).squaredNorm() < reach * reach)
+              return true;
+        }
+    return false;
+  };
   auto project = [&](std::size_t begin) {
     amplified.resize(envelope.Points.size(), 0);
     offset.resize(envelope.Points.size(), 0.0);
@@ -234,6 +278,10 @@ std::size_t projectOntoAmplifiedOffset(
         for (std::size_t i = r.begin(); i != r.end(); ++i)
         {
           Vec3& x = envelope.Points[i];
+          if (!nearActive(x))
+          {
+            continue;
+          }
           Vec3 cp;
           int t = -1;
           double d = 0.0;
@@ -291,8 +339,20 @@ std::size_t projectOntoAmplifiedOffset(
   // that is good enough).
   for (int round = 0; round < 4; ++round)
   {
-    std::vector<char> bad;
-    markSelfIntersecting(envelope, bad);
+    // a fold the projection made involves a moved vertex: only triangles with one are tested
+    std::vector<char> bad, moving(envelope.Triangles.size(), 0);
+    std::size_t movingCount = 0;
+    for (std::size_t f = 0; f < moving.size(); ++f)
+    {
+      const Triangle& t = envelope.Triangles[f];
+      moving[f] = amplified[t[0]] || amplified[t[1]] || amplified[t[2]];
+      movingCount += moving[f];
+    }
+    if (movingCount == 0)
+    {
+      break;
+    }
+    markSelfIntersecting(envelope, bad, &moving);
     std::size_t restored = 0;
     for (std::size_t f = 0; f < bad.size(); ++f)
     {
