@@ -24,7 +24,7 @@ struct IsosurfaceOutput
   bool Cancelled = false;
   std::string Error;
   double DistanceFieldSeconds = 0.0;
-  double IsosurfaceSeconds = 0.0;
+  double IsosurfaceSeconds = 0.0; ///< the extractions and the display field (not the judge's time)
   std::size_t ActiveVoxels = 0;
   std::size_t AmplifiedVoxels = 0; ///< voxels whose value phi changed by more than 1e-3
   double AmplificationSeconds = 0.0; ///< xi -> phi xi on the grid (part of DistanceFieldSeconds)
