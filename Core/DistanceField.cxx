@@ -11,10 +11,12 @@
 #include <openvdb/tools/VolumeToMesh.h>
 #include <openvdb/tree/LeafManager.h>
 
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cmath>
 #include <limits>
 #include <mutex>
@@ -70,11 +72,53 @@ double phiAt(const ActivePoints& amp, const Vec3& x, int triangle, double distan
   return amp.amplificationAt(triangle, closest, distance);
 }
 
+/// Triangle ids sorted by the Morton code of their centroids in cells of two index units
+/// (ties by id, so the order is deterministic).
+std::vector<int> mortonOrder(const std::vector<openvdb::Vec3s>& points, const std::vector<Triangle>& triangles)
+{
+  const auto spread = [](std::uint64_t x) {
+    x &= 0x1FFFFF; // 21 bits per axis
+    x = (x | (x << 32)) & 0x1F00000000FFFFull;
+    x = (x | (x << 16)) & 0x1F0000FF0000FFull;
+    x = (x | (x << 8)) & 0x100F00F00F00F00Full;
+    x = (x | (x << 4)) & 0x10C30C30C30C30C3ull;
+    x = (x | (x << 2)) & 0x1249249249249249ull;
+    return x;
+  };
+  openvdb::Vec3s lo(std::numeric_limits<float>::max());
+  for (const auto& p : points)
+  {
+    lo = openvdb::math::minComponent(lo, p);
+  }
+  std::vector<std::pair<std::uint64_t, int>> keys(triangles.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, triangles.size(), 8192), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t f = r.begin(); f != r.end(); ++f)
+    {
+      const Triangle& t = triangles[f];
+      const openvdb::Vec3s c = (points[t[0]] + points[t[1]] + points[t[2]]) / 3.0f - lo;
+      std::uint64_t code = 0;
+      for (int a = 0; a < 3; ++a)
+      {
+        const double cell = std::floor(std::max(0.0, static_cast<double>(c[a])) / 2.0);
+        code |= spread(static_cast<std::uint64_t>(std::min(cell, 2097151.0))) << a;
+      }
+      keys[f] = { code, static_cast<int>(f) };
+    }
+  });
+  std::sort(keys.begin(), keys.end());
+  std::vector<int> order(keys.size());
+  for (std::size_t f = 0; f < keys.size(); ++f)
+  {
+    order[f] = keys[f].second;
+  }
+  return order;
+}
+
 /// xi -> phi * xi on the active voxels outside the input (values in (0, maxValue]); returns the
 /// number of voxels changed by more than 1e-3 relative.
 /// `noAdapt` (a topology copy of grid's tree) keeps on only the voxels where phi > 1.01.
-std::size_t amplify(openvdb::FloatGrid& grid, const openvdb::Int32Grid& index, const ActivePoints& amp,
-  double voxelSize, float maxValue, openvdb::BoolTree& noAdapt)
+std::size_t amplify(openvdb::FloatGrid& grid, const openvdb::Int32Grid& index, const std::vector<int>& order,
+  const ActivePoints& amp, double voxelSize, float maxValue, openvdb::BoolTree& noAdapt)
 {
   openvdb::tree::LeafManager<openvdb::FloatTree> leaves(grid.tree());
   std::atomic<std::size_t> changed{ 0 };
@@ -97,7 +141,12 @@ std::size_t amplify(openvdb::FloatGrid& grid, const openvdb::Int32Grid& index, c
           continue;
         }
         const openvdb::Coord ijk = it.getCoord();
-        const int t = acc.getValue(ijk);
+        const int position = acc.getValue(ijk);
+        if (position < 0 || position >= static_cast<int>(order.size()))
+        {
+          continue;
+        }
+        const int t = order[position];
         if (t < 0 || t >= triangles)
         {
           continue;
@@ -308,10 +357,15 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
     const Vec3 p = unitMesh.Points[i] / voxelSize;
     points[i] = openvdb::Vec3s(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
   }
-  std::vector<openvdb::Vec3I> tris(unitMesh.Triangles.size());
+  // The triangles go to OpenVDB in Morton order of their centroids (cells of two voxels): its
+  // voxelization gives each thread scratch trees that spatially coherent triangles keep small
+  // and its accessors' caches hit (armadillo_midsub4x: 4.2 -> 2.4 s, armadillo 1.39 -> 1.19 s).
+  // The closest-triangle grid then holds positions in this order: `order` maps them back.
+  const std::vector<int> order = mortonOrder(points, unitMesh.Triangles);
+  std::vector<openvdb::Vec3I> tris(order.size());
   for (std::size_t f = 0; f < tris.size(); ++f)
   {
-    const Triangle& t = unitMesh.Triangles[f];
+    const Triangle& t = unitMesh.Triangles[order[f]];
     tris[f] = openvdb::Vec3I(t[0], t[1], t[2]);
   }
   openvdb::tools::QuadAndTriangleDataAdapter<openvdb::Vec3s, openvdb::Vec3I> adapter(points, tris);
@@ -357,7 +411,7 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
     // phi >= 1, so only where xi <= iso (plus a voxel for the interpolation).
     const auto ta = std::chrono::steady_clock::now();
     noAdapt.reset(new openvdb::BoolTree(grid->tree(), false, openvdb::TopologyCopy()));
-    out.AmplifiedVoxels = amplify(*grid, *closestTriangle, *amplification, voxelSize,
+    out.AmplifiedVoxels = amplify(*grid, *closestTriangle, order, *amplification, voxelSize,
       static_cast<float>(iso + 2.0 * voxelSize), *noAdapt);
     openvdb::tools::dilateActiveValues(*noAdapt, 1);
     closestTriangle.reset();
