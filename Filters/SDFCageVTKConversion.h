@@ -6,9 +6,9 @@
 #include "vtkFieldData.h"
 #include "vtkNew.h"
 
-#include "Envelope.h"
-#include "Mesh.h"
-#include "Progress.h"
+#include "Envelope/Envelope.h"
+#include "Mesh/Mesh.h"
+#include "Common/Progress.h"
 
 #include <string>
 #include <thread>

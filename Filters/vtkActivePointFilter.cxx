@@ -19,7 +19,7 @@
 #include "vtkStringArray.h"
 #include "vtkUnsignedCharArray.h"
 
-#include "ActivePointAnalysis.h"
+#include "Envelope/ActivePointAnalysis.h"
 #include "SDFCageVTKConversion.h"
 
 #include <exception>

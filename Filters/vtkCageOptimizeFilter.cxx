@@ -16,9 +16,9 @@
 #include "vtkPolyData.h"
 #include "vtkStringArray.h"
 
-#include "Normalization.h"
-#include "Optimization.h"
-#include "Validation.h"
+#include "Mesh/Normalization.h"
+#include "Optimization/Optimization.h"
+#include "Mesh/Validation.h"
 #include "SDFCageVTKConversion.h"
 
 #include <exception>

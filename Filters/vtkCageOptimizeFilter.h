@@ -11,12 +11,12 @@
  * @brief   improve a cage (MIPS or spacing energy) while it keeps enclosing its input
  *
  * vtkCageOptimizeFilter implements the optimization of "High-quality Cage Generation Based on
- * SDF" (§3.3, reference/sdf-cage-paper.md). Input 0 is a cage, input 1 (SetSourceConnection) the
+ * SDF" (§3.3). Input 0 is a cage, input 1 (SetSourceConnection) the
  * mesh it encloses. Each vertex of the cage is relocated by gradient descent on
  * E_quality + BarrierWeight * B, B the IPC barrier (eq. 7) over the point-triangle and edge-edge
  * pairs between the vertex's one-ring and the input and the rest of the cage; the line search
- * accepts a step only if it lowers the energy, if continuous collision detection (conservative
- * advancement) shows that no pair comes closer than the clearance along the way, and if the
+ * accepts a step only if it lowers the energy, if a collision-free step test (the whole
+ * move if it is clear, else a bisection on the move fraction) shows that no pair comes closer than the clearance along the way, and if the
  * new one-ring passes the static tests (exact distances to the input, no self-intersection, no
  * flipped or needle triangle). Then edges are flipped where that lowers E_quality and keeps every
  * constraint (and the manifold). The energy is MIPS (eq. 8, equilateral reference: well-shaped

@@ -25,8 +25,8 @@
 #include "vtkSmartPointer.h"
 #include "vtkStringArray.h"
 
-#include "CageQuality.h"
-#include "Progress.h"
+#include "Quality/CageQuality.h"
+#include "Common/Progress.h"
 
 #include <cmath>
 #include <exception>

@@ -25,9 +25,9 @@
 #include "vtkSmartPointer.h"
 #include "vtkStringArray.h"
 
-#include "CageGenerator.h"
+#include "Pipeline/CageGenerator.h"
 #include "SDFCageVTKConversion.h"
-#include "Progress.h"
+#include "Common/Progress.h"
 
 #include <algorithm>
 #include <exception>

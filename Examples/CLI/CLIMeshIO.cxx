@@ -3,7 +3,7 @@
 
 #include "CLIMessages.h"
 
-#include "Shapes.h" // sdfcage::makeBuiltinShape (Core)
+#include "Mesh/Shapes.h" // sdfcage::makeBuiltinShape (Core)
 
 #include <vtkCellArray.h>
 #include <vtkIdTypeArray.h>

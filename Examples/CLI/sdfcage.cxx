@@ -16,7 +16,7 @@
 #include "CLIReport.h"
 #include "CLIScreenshot.h"
 
-#include "Envelope.h" // sdfcage::EnvelopeOptions: what "0 = automatic" resolves to
+#include "Envelope/Envelope.h" // sdfcage::EnvelopeOptions: what "0 = automatic" resolves to
 
 #include <vtkSDFCageFilter.h>
 

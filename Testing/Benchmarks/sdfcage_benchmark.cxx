@@ -1,10 +1,10 @@
 // Envelope-stage benchmark: per mesh, faces, time per stage, peak memory, envelope size,
 // clearance and verdict. Each mesh runs in its own process so that peak memory is per mesh.
-#include "CageGenerator.h"
+#include "Pipeline/CageGenerator.h"
 #include "MeshIO.h"
-#include "Validation.h"
-#include "Shapes.h"
-#include "TriangleTree.h"
+#include "Mesh/Validation.h"
+#include "Mesh/Shapes.h"
+#include "Spatial/TriangleTree.h"
 
 #include <sys/resource.h>
 #include <sys/wait.h>

@@ -6,13 +6,13 @@
 //                              [--save-cage OUT.off] [--cage CAGE.off] [--threads N] [FILE]
 // --save-cage writes the generated cage (input coordinates); --cage reuses one instead of
 // generating it (it must enclose FILE).
-#include "CageGenerator.h"
+#include "Pipeline/CageGenerator.h"
 #include "MeshIO.h"
-#include "Normalization.h"
-#include "Optimization.h"
-#include "Shapes.h"
-#include "TriangleTree.h"
-#include "Validation.h"
+#include "Mesh/Normalization.h"
+#include "Optimization/Optimization.h"
+#include "Mesh/Shapes.h"
+#include "Spatial/TriangleTree.h"
+#include "Mesh/Validation.h"
 
 #include <tbb/global_control.h>
 

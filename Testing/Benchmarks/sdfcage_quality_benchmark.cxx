@@ -4,8 +4,8 @@
 // the best and median wall time, the time per phase of the best run and the verdicts. Without
 // files it uses SDFCAGE_DATA_DIR/armadillo_midsub4x.obj (346k faces) and first builds its cage
 // with --vertices N (default 1000) vertices, as `sdfcage -n 1000` does (this takes a while).
-#include "CageGenerator.h"
-#include "CageQuality.h"
+#include "Pipeline/CageGenerator.h"
+#include "Quality/CageQuality.h"
 #include "MeshIO.h"
 
 #include <algorithm>

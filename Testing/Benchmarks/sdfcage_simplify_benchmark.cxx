@@ -6,12 +6,12 @@
 //   sdfcage_simplify_benchmark [--vertices N] [--repeat K] [--builtin] [MESH ...]
 //   (default: armadillo.obj, octopus-low_surface.obj and anchor.off of SDFCAGE_DATA_DIR, N = 500,
 //   K = 3)
-#include "CageGenerator.h"
-#include "Envelope.h"
+#include "Pipeline/CageGenerator.h"
+#include "Envelope/Envelope.h"
 #include "MeshIO.h"
-#include "Shapes.h"
-#include "Simplification.h"
-#include "TriangleTree.h"
+#include "Mesh/Shapes.h"
+#include "Simplification/Simplification.h"
+#include "Spatial/TriangleTree.h"
 
 #include <algorithm>
 #include <cstdio>

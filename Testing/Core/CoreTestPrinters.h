@@ -2,7 +2,7 @@
 // lookup, so failures print "verification failed" rather than raw bytes).
 #pragma once
 
-#include "Envelope.h"
+#include "Envelope/Envelope.h"
 
 #include <ostream>
 

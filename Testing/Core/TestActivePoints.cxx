@@ -1,15 +1,15 @@
 // SDFCage — Testing: active points, g_A, the amplified field and the shape-aware envelope
 // (paper §3.1), with the envelopes judged by the independent CGAL checker.
-#include "ActivePointAnalysis.h"
-#include "ActivePoints.h"
+#include "Envelope/ActivePointAnalysis.h"
+#include "Envelope/ActivePoints.h"
 #include "CoreTestPrinters.h"
-#include "Envelope.h"
+#include "Envelope/Envelope.h"
 #include "ExactCheck.h"
-#include "Geometry.h"
-#include "Mesh.h"
-#include "Normalization.h"
-#include "Shapes.h"
-#include "Validation.h"
+#include "Spatial/Geometry.h"
+#include "Mesh/Mesh.h"
+#include "Mesh/Normalization.h"
+#include "Mesh/Shapes.h"
+#include "Mesh/Validation.h"
 
 #include <tbb/global_control.h>
 

@@ -1,13 +1,13 @@
 // SDFCage — Testing: evaluateCage (Core/CageQuality) on hand-made good and broken cages, every
 // verdict cross-checked with the independent CGAL checker (Testing/Exact), distances checked
 // against brute force.
-#include "CageQuality.h"
+#include "Quality/CageQuality.h"
 #include "ExactCheck.h"
 #include "MeshIO.h"
-#include "Geometry.h"
-#include "Mesh.h"
-#include "Progress.h"
-#include "Shapes.h"
+#include "Spatial/Geometry.h"
+#include "Mesh/Mesh.h"
+#include "Common/Progress.h"
+#include "Mesh/Shapes.h"
 
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>

@@ -1,14 +1,14 @@
 // SDFCage — Testing: the verified envelope (buildEnvelope) and the pipeline (generateCage),
 // judged by the independent CGAL checker; cancellation and error paths.
-#include "CageGenerator.h"
+#include "Pipeline/CageGenerator.h"
 #include "CoreTestPrinters.h"
-#include "Envelope.h"
+#include "Envelope/Envelope.h"
 #include "ExactCheck.h"
-#include "Geometry.h"
-#include "Mesh.h"
-#include "Normalization.h"
-#include "Progress.h"
-#include "Shapes.h"
+#include "Spatial/Geometry.h"
+#include "Mesh/Mesh.h"
+#include "Mesh/Normalization.h"
+#include "Common/Progress.h"
+#include "Mesh/Shapes.h"
 
 #include <gtest/gtest.h>
 

@@ -1,11 +1,11 @@
 // SDFCage — Testing: Normalization, distance primitives and the triangle index, against
 // brute force and against the independent CGAL checker.
 #include "ExactCheck.h"
-#include "Geometry.h"
-#include "Mesh.h"
-#include "Normalization.h"
-#include "Shapes.h"
-#include "TriangleIndex.h"
+#include "Spatial/Geometry.h"
+#include "Mesh/Mesh.h"
+#include "Mesh/Normalization.h"
+#include "Mesh/Shapes.h"
+#include "Spatial/TriangleIndex.h"
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>

@@ -1,14 +1,14 @@
 // SDFCage — Testing: cage optimization (paper §3.3). Every optimized cage is judged by the
 // independent CGAL checker (exact predicates): closed 2-manifold, same vertex count and genus, no
 // self-intersection, no cage/input intersection, every input vertex inside, clearance >= delta.
-#include "CageGenerator.h"
+#include "Pipeline/CageGenerator.h"
 #include "ExactCheck.h"
-#include "Geometry.h"
-#include "Normalization.h"
-#include "Optimization.h"
-#include "Progress.h"
-#include "Shapes.h"
-#include "TriangleTree.h"
+#include "Spatial/Geometry.h"
+#include "Mesh/Normalization.h"
+#include "Optimization/Optimization.h"
+#include "Common/Progress.h"
+#include "Mesh/Shapes.h"
+#include "Spatial/TriangleTree.h"
 
 #include <gtest/gtest.h>
 

@@ -1,9 +1,9 @@
 // SDFCage — Testing: the procedural shapes, checked with Validation and the CGAL checker.
 #include "ExactCheck.h"
-#include "Mesh.h"
-#include "Normalization.h"
-#include "Shapes.h"
-#include "Validation.h"
+#include "Mesh/Mesh.h"
+#include "Mesh/Normalization.h"
+#include "Mesh/Shapes.h"
+#include "Mesh/Validation.h"
 
 #include <gtest/gtest.h>
 

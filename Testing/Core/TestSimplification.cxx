@@ -1,14 +1,14 @@
 // SDFCage — Testing: constrained QEM simplification (paper §3.2). Every cage is judged by the
 // independent CGAL checker (exact predicates): closed 2-manifold, genus kept, no self-
 // intersection, no cage/input intersection, every input vertex inside, clearance >= delta.
-#include "CageGenerator.h"
-#include "Envelope.h"
+#include "Pipeline/CageGenerator.h"
+#include "Envelope/Envelope.h"
 #include "ExactCheck.h"
-#include "Normalization.h"
-#include "Progress.h"
-#include "Shapes.h"
-#include "Simplification.h"
-#include "TriangleTree.h"
+#include "Mesh/Normalization.h"
+#include "Common/Progress.h"
+#include "Mesh/Shapes.h"
+#include "Simplification/Simplification.h"
+#include "Spatial/TriangleTree.h"
 
 #include <gtest/gtest.h>
 

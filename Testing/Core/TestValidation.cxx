@@ -1,7 +1,7 @@
 // SDFCage — Testing: every defect of Validation.h on hand-built meshes.
-#include "Mesh.h"
-#include "Shapes.h"
-#include "Validation.h"
+#include "Mesh/Mesh.h"
+#include "Mesh/Shapes.h"
+#include "Mesh/Validation.h"
 
 #include <gtest/gtest.h>
 

@@ -10,12 +10,12 @@
 // their topology. The tests therefore use r = 0.08, which makes those parts active, and check
 // that the amplified envelope still has the input's genus and components and encloses exactly.
 #include "../Core/CoreTestPrinters.h"
-#include "ActivePoints.h"
-#include "Envelope.h"
+#include "Envelope/ActivePoints.h"
+#include "Envelope/Envelope.h"
 #include "ExactCheck.h"
 #include "MeshIO.h"
-#include "Normalization.h"
-#include "Validation.h"
+#include "Mesh/Normalization.h"
+#include "Mesh/Validation.h"
 
 #include <gtest/gtest.h>
 

@@ -10,10 +10,10 @@
 // with InvalidInput and a message naming the boundary edges. --inward: the mesh faces inward and
 // validation must flip it. --vertices=N: the cage's vertex count (default: CageOptions' 500).
 #include "../Core/CoreTestPrinters.h"
-#include "CageGenerator.h"
+#include "Pipeline/CageGenerator.h"
 #include "ExactCheck.h"
 #include "MeshIO.h"
-#include "Optimization.h"
+#include "Optimization/Optimization.h"
 
 #include <gtest/gtest.h>
 

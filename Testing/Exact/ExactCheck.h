@@ -6,7 +6,7 @@
 // dependency: Core and Filters never link it.
 #pragma once
 
-#include "Mesh.h"
+#include "Mesh/Mesh.h"
 
 #include <string>
 

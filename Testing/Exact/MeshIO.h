@@ -5,7 +5,7 @@
 // geometry and polygon connectivity only (normals, colours, texture coordinates are skipped).
 #pragma once
 
-#include "Mesh.h"
+#include "Mesh/Mesh.h"
 
 #include <string>
 

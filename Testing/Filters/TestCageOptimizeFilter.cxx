@@ -12,7 +12,7 @@
 #include "vtkSDFCageFilter.h"
 #include "vtkStringArray.h"
 
-#include "Optimization.h" // Core: the default options the filter must mirror
+#include "Optimization/Optimization.h" // Core: the default options the filter must mirror
 
 #include <cmath>
 

@@ -24,8 +24,8 @@
 #include "vtkStringArray.h"
 #include "vtkTriangleFilter.h"
 
-#include "CageGenerator.h" // Core: the default options the filter must mirror
-#include "Shapes.h"   // Core: the built-in test shape
+#include "Pipeline/CageGenerator.h" // Core: the default options the filter must mirror
+#include "Mesh/Shapes.h"   // Core: the built-in test shape
 
 #include <algorithm>
 #include <chrono>

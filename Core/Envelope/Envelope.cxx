@@ -1,0 +1,567 @@
+#include "Envelope/Envelope.h"
+
+#include "Envelope/SDFIsosurface.h"
+#include "Spatial/Geometry.h"
+#include "Common/Progress.h"
+#include "Quality/Verification.h"
+#include "Spatial/TriangleIndex.h"
+#include "Spatial/TriangleTree.h"
+#include "Mesh/Validation.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+#include <tbb/task_group.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <sstream>
+#include <unordered_map>
+
+namespace sdfcage
+{
+
+namespace
+{
+
+double seconds(std::chrono::steady_clock::time_point t0)
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+TriangleMesh keepTriangles(const TriangleMesh& mesh, const std::vector<char>& keep)
+{
+  TriangleMesh out;
+  out.Points = mesh.Points;
+  for (std::size_t f = 0; f < mesh.Triangles.size(); ++f)
+  {
+    if (keep[f])
+    {
+      out.Triangles.push_back(mesh.Triangles[f]);
+    }
+  }
+  removeUnreferencedPoints(out);
+  return out;
+}
+
+/// Keeps the outer boundary: components with negative volume bound trapped air pockets (they face
+/// into the pocket), and positive components nested inside another one are redundant.
+TriangleMesh outerBoundary(const TriangleMesh& surface, int& removed)
+{
+  std::vector<int> comp;
+  const int n = triangleComponents(surface, comp);
+  std::vector<double> volume(n, 0.0);
+  std::vector<int> someVertex(n, -1);
+  for (std::size_t f = 0; f < surface.Triangles.size(); ++f)
+  {
+    const Triangle& t = surface.Triangles[f];
+    volume[comp[f]] += surface.Points[t[0]].dot(surface.Points[t[1]].cross(surface.Points[t[2]])) / 6.0;
+    someVertex[comp[f]] = t[0];
+  }
+  std::vector<char> keepComponent(n, 0);
+  for (int c = 0; c < n; ++c)
+  {
+    keepComponent[c] = volume[c] > 0.0;
+  }
+  // nested positive components (a part inside a cavity of another part)
+  int positive = static_cast<int>(std::count(keepComponent.begin(), keepComponent.end(), 1));
+  if (positive > 1)
+  {
+    for (int c = 0; c < n; ++c)
+    {
+      if (!keepComponent[c])
+      {
+        continue;
+      }
+      for (int o = 0; o < n; ++o)
+      {
+        if (o == c || volume[o] <= 0.0)
+        {
+          continue;
+        }
+        std::vector<char> k(surface.Triangles.size(), 0);
+        for (std::size_t f = 0; f < k.size(); ++f)
+        {
+          k[f] = comp[f] == o;
+        }
+        TriangleMesh other = keepTriangles(surface, k);
+        if (windingNumber(other, surface.Points[someVertex[c]]) > 0.5)
+        {
+          keepComponent[c] = 0;
+          break;
+        }
+      }
+    }
+  }
+  removed = 0;
+  for (int c = 0; c < n; ++c)
+  {
+    removed += !keepComponent[c];
+  }
+  std::vector<char> keep(surface.Triangles.size(), 0);
+  for (std::size_t f = 0; f < keep.size(); ++f)
+  {
+    keep[f] = keepComponent[comp[f]];
+  }
+  return keepTriangles(surface, keep);
+}
+
+
+/// Flags every triangle of `surface` that crosses another one (beyond shared vertices/edges);
+/// with `only`, just the triangles it selects are tested (against all the others).
+void markSelfIntersecting(const TriangleMesh& surface, std::vector<char>& bad, const std::vector<char>* only = nullptr)
+{
+  const std::size_t nf = surface.Triangles.size();
+  bad.resize(nf, 0);
+  TriangleIndex index;
+  index.build(surface);
+  const double foldCosine = -1.0 + 1e-12;
+  const auto box = bounds(surface);
+  const double touching = 1e-12 * std::max(1.0, (box[1] - box[0]).norm());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 2048), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t f = r.begin(); f != r.end(); ++f)
+    {
+      if (only && !(*only)[f])
+      {
+        continue;
+      }
+      const Triangle& t = surface.Triangles[f];
+      const int ia[3] = { t[0], t[1], t[2] };
+      const Vec3 pa[3] = { surface.Points[t[0]], surface.Points[t[1]], surface.Points[t[2]] };
+      const Vec3 lo = pa[0].cwiseMin(pa[1]).cwiseMin(pa[2]);
+      const Vec3 hi = pa[0].cwiseMax(pa[1]).cwiseMax(pa[2]);
+      index.forEachTriangleInBox(lo, hi, [&](int g) {
+        if (static_cast<std::size_t>(g) == f || bad[f])
+        {
+          return;
+        }
+        const Triangle& o = surface.Triangles[g];
+        const int ib[3] = { o[0], o[1], o[2] };
+        const Vec3 pb[3] = { surface.Points[o[0]], surface.Points[o[1]], surface.Points[o[2]] };
+        if (trianglesConflict(ia, pa, ib, pb, touching, foldCosine))
+        {
+          bad[f] = 1; // each triangle only writes its own flag
+        }
+      });
+    }
+  });
+}
+
+/// Where a failed surface is wrong: points on every triangle (sampled about one voxel apart)
+/// that crosses another triangle or comes closer than `clearance` to the input.
+std::vector<Vec3> defectLocations(const TriangleTree& tree, const TriangleMesh& surface, double clearance, double voxel)
+{
+  const std::size_t nf = surface.Triangles.size();
+  std::vector<char> bad(nf, 0);
+  markSelfIntersecting(surface, bad);
+  // clearance
+  {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t f = r.begin(); f != r.end(); ++f)
+      {
+        if (bad[f])
+        {
+          continue;
+        }
+        const Triangle& t = surface.Triangles[f];
+        const Vec3 tri[3] = { surface.Points[t[0]], surface.Points[t[1]], surface.Points[t[2]] };
+        if (tree.anyCloserThan(tri, clearance))
+        {
+          bad[f] = 1;
+        }
+      }
+    });
+  }
+  std::vector<Vec3> points;
+  for (std::size_t f = 0; f < nf; ++f)
+  {
+    if (!bad[f])
+    {
+      continue;
+    }
+    const Triangle& t = surface.Triangles[f];
+    const Vec3 &a = surface.Points[t[0]], &b = surface.Points[t[1]], &c = surface.Points[t[2]];
+    const double longest = std::max({ (b - a).norm(), (c - b).norm(), (a - c).norm() });
+    const int steps = std::max(1, static_cast<int>(std::ceil(longest / voxel)));
+    for (int i = 0; i <= steps; ++i)
+    {
+      for (int j = 0; i + j <= steps; ++j)
+      {
+        const double u = static_cast<double>(i) / steps, v = static_cast<double>(j) / steps;
+        points.push_back(a + u * (b - a) + v * (c - a));
+      }
+    }
+  }
+  return points;
+}
+
+/// Near active points the isosurface xi^ = c lies at xi = c / phi, closer to the input than the
+/// grid resolves (a voxel is c/2, the offset there down to c/alpha): its chords cut corners.
+/// There, the envelope is refined (edges split down to `maxEdge`) and every vertex where phi is
+/// noticeably above 1 is moved along the distance gradient (away from its closest input point)
+/// onto the exact solution of phi(g_A + d) d = c. Returns the number of vertices moved.
+std::size_t projectOntoAmplifiedOffset(
+  TriangleMesh& envelope, const ActivePoints& amp, const TriangleTree& tree, double c, double maxEdge)
+{
+  std::vector<char> amplified;
+  std::vector<double> offset; // distance to the input after the projection
+  std::vector<Vec3> original = envelope.Points; // where the grid put them (midpoints: of the chord)
+  std::atomic<std::size_t> moved{ 0 };
+  // phi - 1 <= 1e-3 (alpha - 1), below which nothing moves, once d^ >= sqrt(ln 1000) / beta. As
+  // d^ = g_A(P(x)) + d(x), with g_A at a surface point at least its distance to the active
+  // points less one edge of the refined surface, a vertex farther than that plus the longest
+  // edge from every active point stays: a hashed grid of the active points answers it.
+  double longestEdge = 0.0;
+  for (const Triangle& t : amp.Surface.Triangles)
+    for (int k = 0; k < 3; ++k)
+      longestEdge = std::max(longestEdge, (amp.Surface.Points[t[k]] - amp.Surface.Points[t[(k + 1) % 3]]).norm());
+  const double reach = std::sqrt(std::log(1000.0)) / amp.Beta + longestEdge;
+  std::unordered_map<std::int64_t, std::vector<Vec3>> activeCells;
+  auto cellKey = [reach](std::int64_t i, std::int64_t j, std::int64_t k) {
+    return ((k & 0x1FFFFF) << 42) | ((j & 0x1FFFFF) << 21) | (i & 0x1FFFFF);
+  };
+  auto cellOf = [reach](double x) { return static_cast<std::int64_t>(std::floor(x / reach)); };
+  for (std::size_t i = 0; i < amp.Surface.Points.size() && i < amp.Active.size(); ++i)
+  {
+    if (amp.Active[i])
+    {
+      const Vec3& a = amp.Surface.Points[i];
+      activeCells[cellKey(cellOf(a.x()), cellOf(a.y()), cellOf(a.z()))].push_back(a);
+    }
+  }
+  auto nearActive = [&](const Vec3& x) {
+    const std::int64_t ci = cellOf(x.x()), cj = cellOf(x.y()), ck = cellOf(x.z());
+    for (std::int64_t k = ck - 1; k <= ck + 1; ++k)
+      for (std::int64_t j = cj - 1; j <= cj + 1; ++j)
+        for (std::int64_t i = ci - 1; i <= ci + 1; ++i)
+        {
+          const auto it = activeCells.find(cellKey(i, j, k));
+          if (it == activeCells.end())
+            continue;
+          for (const Vec3& a : it->second)
+            if ((a - x).squaredNorm() < reach * reach)
+              return true;
+        }
+    return false;
+  };
+  auto project = [&](std::size_t begin) {
+    amplified.resize(envelope.Points.size(), 0);
+    offset.resize(envelope.Points.size(), 0.0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(begin, envelope.Points.size(), 1024),
+      [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i)
+        {
+          Vec3& x = envelope.Points[i];
+          if (!nearActive(x))
+          {
+            continue;
+          }
+          Vec3 cp;
+          int t = -1;
+          double d = 0.0;
+          if (!tree.closestPoint(x, 2.0 * c, cp, t, d) || !(d > 0.0))
+          {
+            continue;
+          }
+          if (!(amp.amplificationAt(t, cp, d) > 1.0 + 1e-3 * (amp.Alpha - 1.0)))
+          {
+            continue;
+          }
+          // f(s) = phi(g + s) s - c is increasing on the relevant range: f(0) < 0 <= f(c)
+          double lo = 0.0, hi = c;
+          for (int k = 0; k < 40; ++k)
+          {
+            const double mid = 0.5 * (lo + hi);
+            (amp.amplificationAt(t, cp, mid) * mid < c ? lo : hi) = mid;
+          }
+          original[i] = x;
+          x = cp + (x - cp) * (hi / d);
+          amplified[i] = 1;
+          offset[i] = hi;
+          ++moved;
+        }
+      });
+  };
+  project(0);
+  const double m2 = maxEdge * maxEdge;
+  for (int round = 0; round < 3; ++round)
+  {
+    const std::size_t before = envelope.Points.size();
+    // only chords that sag: where the offset surface curves (around rims and edges of the
+    // input) its chords come closer to the input than their ends; flat parts are left alone
+    const std::size_t created = splitEdges(envelope, [&](int a, int b) {
+      if (!(amplified[a] && amplified[b]) || (envelope.Points[a] - envelope.Points[b]).squaredNorm() <= m2)
+      {
+        return false;
+      }
+      const double sag = tree.distance(0.5 * (envelope.Points[a] + envelope.Points[b]));
+      return sag < 0.9 * std::min(offset[a], offset[b]);
+    });
+    if (created == 0)
+    {
+      break;
+    }
+    original.resize(envelope.Points.size());
+    for (std::size_t i = before; i < envelope.Points.size(); ++i)
+    {
+      original[i] = envelope.Points[i];
+    }
+    project(before);
+  }
+  // Moving vertices along diverging or converging normals can fold the surface in tight concave
+  // places: there, the vertices go back to where the grid put them (verification decides whether
+  // that is good enough).
+  for (int round = 0; round < 4; ++round)
+  {
+    // a fold the projection made involves a moved vertex: only triangles with one are tested
+    std::vector<char> bad, moving(envelope.Triangles.size(), 0);
+    std::size_t movingCount = 0;
+    for (std::size_t f = 0; f < moving.size(); ++f)
+    {
+      const Triangle& t = envelope.Triangles[f];
+      moving[f] = amplified[t[0]] || amplified[t[1]] || amplified[t[2]];
+      movingCount += moving[f];
+    }
+    if (movingCount == 0)
+    {
+      break;
+    }
+    markSelfIntersecting(envelope, bad, &moving);
+    std::size_t restored = 0;
+    for (std::size_t f = 0; f < bad.size(); ++f)
+    {
+      if (!bad[f])
+      {
+        continue;
+      }
+      for (int k = 0; k < 3; ++k)
+      {
+        const int v = envelope.Triangles[f][k];
+        if (amplified[v])
+        {
+          envelope.Points[v] = original[v];
+          amplified[v] = 0;
+          ++restored;
+        }
+      }
+    }
+    if (restored == 0)
+    {
+      break;
+    }
+    moved -= restored;
+  }
+  return moved.load();
+}
+
+} // namespace
+
+EnvelopeResult buildEnvelope(
+  const TriangleMesh& unitInput, const EnvelopeOptions& options, Progress* progress, double progressEnd)
+{
+  EnvelopeResult result;
+  if (unitInput.empty())
+  {
+    result.State = Status::EmptyInput;
+    result.Message = "the input has no triangles";
+    return result;
+  }
+  const double c = options.IsoValue;
+  double h = options.voxelSize();
+  const double delta = options.clearance();
+  if (!(c > 0.0) || !(h > 0.0) || !(delta > 0.0) || delta >= c)
+  {
+    result.State = Status::InvalidInput;
+    result.Message = "invalid parameters: need IsoValue > 0, VoxelSize > 0 and 0 < MinimumClearance < IsoValue";
+    return result;
+  }
+  // The input's tree for the verification is built meanwhile (on another thread when there is
+  // one): the active points and the distance field come first.
+  auto inputTree = std::make_shared<TriangleTree>();
+  tbb::task_group treeTask;
+  treeTask.run([&unitInput, inputTree] { inputTree->build(unitInput); });
+  struct WaitFor
+  {
+    tbb::task_group& Group;
+    ~WaitFor()
+    {
+      try
+      {
+        Group.wait();
+      }
+      catch (...) // out of memory in the build: nothing to do on the way out
+      {
+      }
+    }
+  } waitForTree{ treeTask }; // every return path waits for it
+  bool treeReady = false;
+  auto tree = [&]() -> const TriangleTree& {
+    if (!treeReady)
+    {
+      treeTask.wait();
+      treeReady = true;
+    }
+    return *inputTree;
+  };
+  {
+    std::vector<int> comp;
+    result.InputComponents = triangleComponents(unitInput, comp);
+    result.InputGenus = genus(unitInput);
+  }
+  ActivePoints active;
+  const ActivePoints* amplification = nullptr;
+  std::unique_ptr<TriangleTree> surfaceTree;
+  if (options.UseActivePoints)
+  {
+    const std::string bad = options.ActivePoints.validate();
+    if (!bad.empty())
+    {
+      result.State = Status::InvalidInput;
+      result.Message = "invalid active-point parameters: " + bad;
+      return result;
+    }
+    progressStage(progress, "active points", 0.02, 0.12 * progressEnd);
+    active = computeActivePoints(unitInput, options.ActivePoints, progress);
+    result.ActivePointSeconds = active.Seconds;
+    if (active.Cancelled || progressCancelled(progress))
+    {
+      result.State = Status::Cancelled;
+      result.Message = "cancelled";
+      return result;
+    }
+    result.NumberOfActivePoints = active.NumberOfActiveInputPoints;
+    result.NumberOfActiveSamples = active.NumberOfActiveSamples;
+    amplification = &active;
+    if (!active.empty())
+    {
+      surfaceTree = std::make_unique<TriangleTree>(active.Surface);
+    }
+  }
+  const double fieldBegin = options.UseActivePoints ? 0.12 * progressEnd : 0.02;
+  // Attempts: the requested grid, first with the requested adaptivity and, if that envelope fails
+  // verification (merged polygons can cut corners or cross), without it from the same field; then
+  // finer grids without adaptivity.
+  int attempt = 0;
+  const int levels = 1 + std::max(0, options.MaximumRefinements);
+  for (int level = 0; level < levels; ++level, h *= 0.5)
+  {
+    std::vector<double> adaptivities{ 0.0 };
+    if (level == 0 && options.Adaptivity > 0)
+    {
+      adaptivities = { options.Adaptivity, 0.0 };
+    }
+    progressStage(progress, "distance field and isosurface", fieldBegin, 0.7 * progressEnd);
+    // Each extracted surface is judged here: outer boundary, then the full verification. A
+    // failing adaptive surface is re-extracted with adaptivity off around its defects.
+    bool accepted = false;
+    const SurfaceJudge judge = [&](const TriangleMesh& surface, double adaptivity, std::vector<Vec3>& repairNear) {
+      auto t0 = std::chrono::steady_clock::now();
+      int pockets = 0;
+      TriangleMesh envelope = outerBoundary(surface, pockets);
+      if (amplification && surfaceTree)
+      {
+        result.ProjectedVertices = projectOntoAmplifiedOffset(envelope, *amplification, *surfaceTree, c, 0.5 * h);
+      }
+      result.IsosurfaceSeconds += seconds(t0);
+      progressStage(progress, "verifying enclosure", 0.7 * progressEnd, progressEnd);
+      auto t1 = std::chrono::steady_clock::now();
+      std::string why;
+      double clearance = 0.0;
+      std::vector<double> distances;
+      const bool ok = verifyEnclosure(unitInput, envelope, delta, clearance, why, &distances, progress,
+        options.ExactEnvelopeClearance, &tree());
+      ++attempt;
+      if (ok)
+      {
+        result.Envelope = std::move(envelope);
+        result.DistanceToInput = std::move(distances);
+        result.MinimumClearance = clearance;
+        result.RemovedPockets = pockets;
+        result.VoxelSizeUsed = h;
+        result.AdaptivityUsed = adaptivity;
+        result.Refinements = level;
+        accepted = true;
+      }
+      else if (!progressCancelled(progress))
+      {
+        std::ostringstream m;
+        m << "envelope at voxel size " << h << " (adaptivity " << adaptivity << ") failed verification: " << why;
+        result.Message = m.str();
+        if (std::getenv("SDFCAGE_DEBUG_ENVELOPE"))
+        {
+          std::fprintf(stderr, "%s\n", result.Message.c_str());
+        }
+        if (adaptivity > 0.0)
+        {
+          repairNear = defectLocations(tree(), envelope, delta, h);
+        }
+      }
+      result.VerificationSeconds += seconds(t1);
+      return ok;
+    };
+    IsosurfaceOutput iso = computeIsosurface(
+      unitInput, h, c, options.KeepDistanceField, progress, adaptivities, amplification, &judge, 4);
+    result.AmplifiedVoxels = iso.AmplifiedVoxels;
+    result.AmplificationSeconds += iso.AmplificationSeconds;
+    result.AdaptiveRepairs = iso.Repairs;
+    result.DistanceFieldSeconds += iso.DistanceFieldSeconds;
+    result.IsosurfaceSeconds += iso.IsosurfaceSeconds;
+    if (iso.Cancelled || progressCancelled(progress))
+    {
+      result.State = Status::Cancelled;
+      result.Message = "cancelled";
+      return result;
+    }
+    if (!iso.Error.empty())
+    {
+      result.State = Status::Failed;
+      result.Message = iso.Error;
+      return result;
+    }
+    result.DistanceField = std::move(iso.Field);
+    result.ModifiedDistanceField = std::move(iso.ModifiedField);
+    if (accepted)
+    {
+      std::vector<int> comp;
+      result.Components = triangleComponents(result.Envelope, comp);
+      result.Genus = genus(result.Envelope);
+      if (result.Genus != result.InputGenus || result.Components != result.InputComponents)
+      {
+        std::ostringstream w;
+        w << "the envelope has genus " << result.Genus << " and " << result.Components
+          << " component(s), the input genus " << result.InputGenus << " and "
+          << result.InputComponents << ": parts of the input closer than the parameters can "
+          << "separate were fused";
+        if (!options.UseActivePoints)
+        {
+          w << " (active points are off: turn them on)";
+        }
+        else
+        {
+          w << " (try a smaller IsoValue and VoxelSize, or a larger ActiveRadius / AmplificationAlpha)";
+        }
+        result.TopologyWarning = w.str();
+      }
+      result.EnclosureVerified = true;
+      result.State = Status::Ok;
+      result.Message.clear();
+      tree();
+      result.InputTree = inputTree;
+      return result;
+    }
+  }
+  result.State = Status::VerificationFailed;
+  result.EnclosureVerified = false;
+  result.Message += " (after " + std::to_string(attempt) +
+    " attempts with finer grids; try a larger IsoValue or a smaller VoxelSize)";
+  return result;
+}
+
+} // namespace sdfcage

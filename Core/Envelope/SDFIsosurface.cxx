@@ -1,0 +1,486 @@
+#include "Envelope/SDFIsosurface.h"
+
+#include "Envelope/ActivePoints.h"
+#include "Spatial/Geometry.h"
+#include "Common/Progress.h"
+
+#include <openvdb/openvdb.h>
+#include <openvdb/tools/Interpolation.h>
+#include <openvdb/tools/MeshToVolume.h>
+#include <openvdb/tools/Morphology.h>
+#include <openvdb/tools/VolumeToMesh.h>
+#include <openvdb/tree/LeafManager.h>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <cmath>
+#include <limits>
+#include <mutex>
+#include <cstdlib>
+
+namespace sdfcage
+{
+
+namespace
+{
+
+/// OpenVDB interrupter backed by our Progress: one mechanism for both.
+class VdbInterrupter : public openvdb::util::NullInterrupter
+{
+public:
+  VdbInterrupter(Progress* p, double begin, double end)
+    : P(p)
+    , Begin(begin)
+    , End(end)
+  {
+  }
+  bool wasInterrupted(int percent = -1) override
+  {
+    if (!P)
+    {
+      return false;
+    }
+    if (percent >= 0)
+    {
+      P->update(Begin + (End - Begin) * std::clamp(percent, 0, 100) / 100.0);
+    }
+    return P->cancelled();
+  }
+
+private:
+  Progress* P;
+  double Begin, End;
+};
+
+double seconds(std::chrono::steady_clock::time_point t0)
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::once_flag vdbInit;
+
+/// phi at world position x (unit-sphere units) given the closest triangle of amp.Surface.
+double phiAt(const ActivePoints& amp, const Vec3& x, int triangle, double distance)
+{
+  const Triangle& t = amp.Surface.Triangles[triangle];
+  const Vec3 closest = closestPointOnTriangle(
+    x, amp.Surface.Points[t[0]], amp.Surface.Points[t[1]], amp.Surface.Points[t[2]]);
+  return amp.amplificationAt(triangle, closest, distance);
+}
+
+/// Triangle ids sorted by the Morton code of their centroids in cells of two index units
+/// (ties by id, so the order is deterministic).
+std::vector<int> mortonOrder(const std::vector<openvdb::Vec3s>& points, const std::vector<Triangle>& triangles)
+{
+  const auto spread = [](std::uint64_t x) {
+    x &= 0x1FFFFF; // 21 bits per axis
+    x = (x | (x << 32)) & 0x1F00000000FFFFull;
+    x = (x | (x << 16)) & 0x1F0000FF0000FFull;
+    x = (x | (x << 8)) & 0x100F00F00F00F00Full;
+    x = (x | (x << 4)) & 0x10C30C30C30C30C3ull;
+    x = (x | (x << 2)) & 0x1249249249249249ull;
+    return x;
+  };
+  openvdb::Vec3s lo(std::numeric_limits<float>::max());
+  for (const auto& p : points)
+  {
+    lo = openvdb::math::minComponent(lo, p);
+  }
+  std::vector<std::pair<std::uint64_t, int>> keys(triangles.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, triangles.size(), 8192), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t f = r.begin(); f != r.end(); ++f)
+    {
+      const Triangle& t = triangles[f];
+      const openvdb::Vec3s c = (points[t[0]] + points[t[1]] + points[t[2]]) / 3.0f - lo;
+      std::uint64_t code = 0;
+      for (int a = 0; a < 3; ++a)
+      {
+        const double cell = std::floor(std::max(0.0, static_cast<double>(c[a])) / 2.0);
+        code |= spread(static_cast<std::uint64_t>(std::min(cell, 2097151.0))) << a;
+      }
+      keys[f] = { code, static_cast<int>(f) };
+    }
+  });
+  std::sort(keys.begin(), keys.end());
+  std::vector<int> order(keys.size());
+  for (std::size_t f = 0; f < keys.size(); ++f)
+  {
+    order[f] = keys[f].second;
+  }
+  return order;
+}
+
+/// xi -> phi * xi on the active voxels outside the input (values in (0, maxValue]); returns the
+/// number of voxels changed by more than 1e-3 relative.
+/// `noAdapt` (a topology copy of grid's tree) keeps on only the voxels where phi > 1.01.
+std::size_t amplify(openvdb::FloatGrid& grid, const openvdb::Int32Grid& index, const std::vector<int>& order,
+  const ActivePoints& amp, double voxelSize, float maxValue, openvdb::BoolTree& noAdapt)
+{
+  openvdb::tree::LeafManager<openvdb::FloatTree> leaves(grid.tree());
+  std::atomic<std::size_t> changed{ 0 };
+  const int triangles = static_cast<int>(amp.Surface.Triangles.size());
+  tbb::parallel_for(leaves.leafRange(), [&](const openvdb::tree::LeafManager<openvdb::FloatTree>::LeafRange& range) {
+    auto acc = index.getConstAccessor();
+    std::size_t local = 0;
+    for (auto leaf = range.begin(); leaf; ++leaf)
+    {
+      openvdb::BoolTree::LeafNodeType* maskLeaf = noAdapt.probeLeaf(leaf->origin());
+      for (auto it = leaf->beginValueOn(); it; ++it)
+      {
+        const float v = *it;
+        if (!(v > 0.0f) || v > maxValue)
+        {
+          if (maskLeaf)
+          {
+            maskLeaf->setValueOff(it.pos());
+          }
+          continue;
+        }
+        const openvdb::Coord ijk = it.getCoord();
+        const int position = acc.getValue(ijk);
+        if (position < 0 || position >= static_cast<int>(order.size()))
+        {
+          continue;
+        }
+        const int t = order[position];
+        if (t < 0 || t >= triangles)
+        {
+          continue;
+        }
+        const Vec3 x(ijk.x() * voxelSize, ijk.y() * voxelSize, ijk.z() * voxelSize);
+        const double phi = phiAt(amp, x, t, v);
+        if (phi > 1.001)
+        {
+          ++local;
+        }
+        if (maskLeaf && !(phi > 1.0 + 0.01 * (amp.Alpha - 1.0)))
+        {
+          maskLeaf->setValueOff(it.pos());
+        }
+        it.setValue(static_cast<float>(phi * v));
+      }
+    }
+    changed += local;
+  });
+  return changed.load();
+}
+
+
+/// The isosurface {value = iso} of `grid` (unit-sphere units), quads split on the shorter
+/// diagonal, counter-clockwise seen from outside; no adaptivity inside `noAdapt`.
+TriangleMesh extract(const openvdb::FloatGrid& grid, double iso, double adaptivity, const openvdb::BoolTree::Ptr& noAdapt)
+{
+  openvdb::tools::VolumeToMesh mesher(iso, adaptivity, true);
+  if (noAdapt && adaptivity > 0.0)
+  {
+    mesher.setAdaptivityMask(noAdapt);
+  }
+  mesher(grid);
+  TriangleMesh s;
+  s.Points.resize(mesher.pointListSize());
+  const auto& pts = mesher.pointList();
+  for (std::size_t i = 0; i < s.Points.size(); ++i)
+  {
+    s.Points[i] = Vec3(pts[i].x(), pts[i].y(), pts[i].z());
+  }
+  const openvdb::tools::PolygonPoolList& pools = mesher.polygonPoolList();
+  for (std::size_t n = 0; n < mesher.polygonPoolListSize(); ++n)
+  {
+    const openvdb::tools::PolygonPool& pool = pools[n];
+    // OpenVDB's polygons wind clockwise seen from outside; we store counter-clockwise.
+    for (std::size_t i = 0; i < pool.numTriangles(); ++i)
+    {
+      const openvdb::Vec3I& t = pool.triangle(i);
+      s.Triangles.push_back({ static_cast<int>(t[0]), static_cast<int>(t[2]), static_cast<int>(t[1]) });
+    }
+    for (std::size_t i = 0; i < pool.numQuads(); ++i)
+    {
+      const openvdb::Vec4I& q = pool.quad(i);
+      const int a = q[0], b = q[1], c = q[2], d = q[3];
+      // split along the shorter diagonal (better-shaped triangles)
+      if ((s.Points[a] - s.Points[c]).squaredNorm() <= (s.Points[b] - s.Points[d]).squaredNorm())
+      {
+        s.Triangles.push_back({ a, c, b });
+        s.Triangles.push_back({ a, d, c });
+      }
+      else
+      {
+        s.Triangles.push_back({ a, d, b });
+        s.Triangles.push_back({ b, d, c });
+      }
+    }
+  }
+  return s;
+}
+
+/// Marks the voxels within `radius` voxels of each point (unit-sphere units).
+void markAround(const std::vector<Vec3>& points, double voxelSize, int radius, openvdb::BoolTree& mask)
+{
+  openvdb::tree::ValueAccessor<openvdb::BoolTree> acc(mask);
+  for (const Vec3& p : points)
+  {
+    const openvdb::Coord c(static_cast<int>(std::lround(p.x() / voxelSize)),
+      static_cast<int>(std::lround(p.y() / voxelSize)), static_cast<int>(std::lround(p.z() / voxelSize)));
+    for (int k = -radius; k <= radius; ++k)
+      for (int j = -radius; j <= radius; ++j)
+        for (int i = -radius; i <= radius; ++i)
+        {
+          acc.setValueOn(c.offsetBy(i, j, k), true);
+        }
+  }
+}
+
+} // namespace
+
+bool computeDisplayFields(const TriangleMesh& unitMesh, double iso, double minSpacing,
+  const ActivePoints* amplification, ScalarImage& field, ScalarImage* modified, std::string& error)
+{
+  std::call_once(vdbInit, []() { openvdb::initialize(); });
+  if (amplification && amplification->empty())
+  {
+    amplification = nullptr;
+  }
+  const double voxelSize = minSpacing;
+  std::vector<openvdb::Vec3I> tris(unitMesh.Triangles.size());
+  for (std::size_t f = 0; f < tris.size(); ++f)
+  {
+    const Triangle& t = unitMesh.Triangles[f];
+    tris[f] = openvdb::Vec3I(t[0], t[1], t[2]);
+  }
+
+  // For display: a separate, coarser field (at most 256 samples per axis) over the whole box
+  // with the interior filled and a wide exterior band, so slices and contours show the real
+  // distances rather than the narrow band the envelope needs.
+  const auto box = bounds(unitMesh);
+  const double extent = (box[1] - box[0]).maxCoeff() + 4.0 * iso;
+  const double spacing = std::max(voxelSize, extent / 255.0);
+  std::vector<openvdb::Vec3s> coarsePoints(unitMesh.Points.size());
+  for (std::size_t i = 0; i < coarsePoints.size(); ++i)
+  {
+    const Vec3 p = unitMesh.Points[i] / spacing;
+    coarsePoints[i] = openvdb::Vec3s(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
+  }
+  openvdb::tools::QuadAndTriangleDataAdapter<openvdb::Vec3s, openvdb::Vec3I> coarseAdapter(coarsePoints, tris);
+  auto coarseTransform = openvdb::math::Transform::createLinearTransform(spacing);
+  // With amplification the exterior band also covers where phi differs from 1 noticeably
+  // (phi - 1 < 2e-4 (alpha - 1) beyond 0.36 at beta = 8), and closest triangles are kept.
+  double bandWorld = 2.0 * iso + 8.0 * spacing;
+  openvdb::Int32Grid::Ptr displayTriangle;
+  if (amplification)
+  {
+    bandWorld = std::max(bandWorld, std::min(amplification->Cutoff, 3.0 / amplification->Beta));
+    displayTriangle = openvdb::Int32Grid::create(-1);
+  }
+  const float band = static_cast<float>(std::ceil(bandWorld / spacing) + 1.0);
+  openvdb::FloatGrid::Ptr grid;
+  try
+  {
+    openvdb::util::NullInterrupter none;
+    grid = openvdb::tools::meshToVolume<openvdb::FloatGrid>(none, coarseAdapter, *coarseTransform,
+      band, std::numeric_limits<float>::max(), 0, displayTriangle.get());
+  }
+  catch (const std::exception& e)
+  {
+    error = std::string("OpenVDB could not compute the display field: ") + e.what();
+    return false;
+  }
+  ScalarImage& img = field;
+  img.Spacing = spacing;
+  // samples on the voxel centres of the display grid (no interpolation)
+  openvdb::Coord first, last;
+  for (int a = 0; a < 3; ++a)
+  {
+    first[a] = static_cast<int>(std::floor((box[0][a] - 2.0 * iso) / spacing)) - 2;
+    last[a] = static_cast<int>(std::ceil((box[1][a] + 2.0 * iso) / spacing)) + 2;
+    img.Dimensions[a] = last[a] - first[a] + 1;
+  }
+  img.Origin = Vec3(first.x(), first.y(), first.z()) * spacing;
+  const std::size_t count = static_cast<std::size_t>(img.Dimensions[0]) * img.Dimensions[1] * img.Dimensions[2];
+  img.Values.resize(count);
+  if (modified)
+  {
+    *modified = img;
+    modified->Values.resize(count);
+  }
+  const int nx = img.Dimensions[0], ny = img.Dimensions[1];
+  const int triangles = static_cast<int>(unitMesh.Triangles.size());
+  tbb::parallel_for(0, img.Dimensions[2], [&](int k) {
+    auto acc = grid->getConstAccessor();
+    std::unique_ptr<openvdb::Int32Grid::ConstAccessor> tri;
+    if (displayTriangle)
+    {
+      tri = std::make_unique<openvdb::Int32Grid::ConstAccessor>(displayTriangle->getConstAccessor());
+    }
+    std::size_t n = static_cast<std::size_t>(k) * nx * ny;
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i, ++n)
+      {
+        const openvdb::Coord ijk(first.x() + i, first.y() + j, first.z() + k);
+        const float v = acc.getValue(ijk);
+        img.Values[n] = v;
+        if (tri && modified)
+        {
+          const int t = tri->getValue(ijk);
+          double phi = 1.0;
+          if (t >= 0 && t < triangles)
+          {
+            phi = phiAt(*amplification, Vec3(ijk.x(), ijk.y(), ijk.z()) * spacing, t, std::abs(v));
+          }
+          modified->Values[n] = static_cast<float>(phi * v);
+        }
+      }
+  });
+  return true;
+}
+
+IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSize, double iso,
+  bool keepField, Progress* progress, const std::vector<double>& adaptivities,
+  const ActivePoints* amplification, const SurfaceJudge* judge, int maxRepairs)
+{
+  std::call_once(vdbInit, []() { openvdb::initialize(); });
+  if (amplification && amplification->empty())
+  {
+    amplification = nullptr; // no active point: phi = 1 everywhere
+  }
+  const TriangleMesh& unitMesh = amplification ? amplification->Surface : unitInput;
+  IsosurfaceOutput out;
+  auto t0 = std::chrono::steady_clock::now();
+
+  // mesh in index space (voxel centres at integer coordinates)
+  std::vector<openvdb::Vec3s> points(unitMesh.Points.size());
+  for (std::size_t i = 0; i < points.size(); ++i)
+  {
+    const Vec3 p = unitMesh.Points[i] / voxelSize;
+    points[i] = openvdb::Vec3s(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
+  }
+  // The triangles go to OpenVDB in Morton order of their centroids (cells of two voxels): its
+  // voxelization gives each thread scratch trees that spatially coherent triangles keep small
+  // and its accessors' caches hit (armadillo_midsub4x: 4.2 -> 2.4 s, armadillo 1.39 -> 1.19 s).
+  // The closest-triangle grid then holds positions in this order: `order` maps them back.
+  const std::vector<int> order = mortonOrder(points, unitMesh.Triangles);
+  std::vector<openvdb::Vec3I> tris(order.size());
+  for (std::size_t f = 0; f < tris.size(); ++f)
+  {
+    const Triangle& t = unitMesh.Triangles[order[f]];
+    tris[f] = openvdb::Vec3I(t[0], t[1], t[2]);
+  }
+  openvdb::tools::QuadAndTriangleDataAdapter<openvdb::Vec3s, openvdb::Vec3I> adapter(points, tris);
+  auto transform = openvdb::math::Transform::createLinearTransform(voxelSize);
+
+  // The isosurface at `iso` needs values up to iso plus one voxel. Corners beyond the band read the
+  // background (band width), which is still > iso: the crossing can only move outward (the safe
+  // side), and the envelope is verified anyway. Inside, one voxel is enough: the flood fill gives
+  // the interior its sign. Narrow bands are most of the speed of this stage.
+  const float exteriorBand = static_cast<float>(std::ceil(iso / voxelSize) + 1.0);
+  const float interiorBand = 1.0f;
+  VdbInterrupter sdfInterrupter(progress, 0.0, 0.6);
+  openvdb::FloatGrid::Ptr grid;
+  openvdb::Int32Grid::Ptr closestTriangle;
+  if (amplification)
+  {
+    closestTriangle = openvdb::Int32Grid::create(-1);
+  }
+  try
+  {
+    grid = openvdb::tools::meshToVolume<openvdb::FloatGrid>(
+      sdfInterrupter, adapter, *transform, exteriorBand, interiorBand, 0, closestTriangle.get());
+  }
+  catch (const std::exception& e)
+  {
+    out.Error = std::string("OpenVDB could not compute the distance field: ") + e.what();
+    return out;
+  }
+  out.DistanceFieldSeconds = seconds(t0);
+  if (progressCancelled(progress) || !grid)
+  {
+    out.Cancelled = true;
+    return out;
+  }
+  out.ActiveVoxels = grid->activeVoxelCount();
+  // Voxels where adaptivity is switched off: near active points (the amplified envelope lies
+  // close to the input there, merged polygons would cut into the clearance) and, after a failed
+  // judgement, around the triangles the judge points at.
+  openvdb::BoolTree::Ptr noAdapt(new openvdb::BoolTree(false));
+  if (amplification)
+  {
+    // xi^ = phi xi (eq. 2–3) wherever the isosurface xi^ = iso can lie or be interpolated from:
+    // phi >= 1, so only where xi <= iso (plus a voxel for the interpolation).
+    const auto ta = std::chrono::steady_clock::now();
+    noAdapt.reset(new openvdb::BoolTree(grid->tree(), false, openvdb::TopologyCopy()));
+    out.AmplifiedVoxels = amplify(*grid, *closestTriangle, order, *amplification, voxelSize,
+      static_cast<float>(iso + 2.0 * voxelSize), *noAdapt);
+    openvdb::tools::dilateActiveValues(*noAdapt, 1);
+    closestTriangle.reset();
+    out.AmplificationSeconds = seconds(ta);
+    out.DistanceFieldSeconds += out.AmplificationSeconds;
+  }
+
+  // the extractions and the display field only: the judge's time is its caller's to count
+  double extractionSeconds = 0.0;
+  for (std::size_t k = 0; k < adaptivities.size(); ++k)
+  {
+    const double adaptivity = adaptivities[k];
+    const int rounds = (judge && adaptivity > 0.0) ? 1 + std::max(0, maxRepairs) : 1;
+    for (int round = 0; round < rounds; ++round)
+    {
+      TriangleMesh surface;
+      const auto te = std::chrono::steady_clock::now();
+      try
+      {
+        surface = extract(*grid, iso, adaptivity, noAdapt->empty() ? nullptr : noAdapt);
+        extractionSeconds += seconds(te);
+      }
+      catch (const std::exception& e)
+      {
+        out.Error = std::string("OpenVDB could not extract the isosurface: ") + e.what();
+        return out;
+      }
+      if (!judge)
+      {
+        out.Surfaces.push_back(std::move(surface));
+        break;
+      }
+      std::vector<Vec3> repairNear;
+      const bool accepted = (*judge)(surface, adaptivity, repairNear);
+      if (progressCancelled(progress))
+      {
+        out.Cancelled = true;
+        return out;
+      }
+      if (accepted)
+      {
+        out.Surfaces.push_back(std::move(surface));
+        out.AcceptedAdaptivity = adaptivity;
+        out.Repairs = round;
+        break;
+      }
+      if (repairNear.empty() || adaptivity <= 0.0)
+      {
+        break;
+      }
+      markAround(repairNear, voxelSize, 2, *noAdapt);
+    }
+    if (!out.Surfaces.empty() && judge)
+    {
+      break;
+    }
+  }
+  progressUpdate(progress, 0.9);
+
+  const auto tf = std::chrono::steady_clock::now();
+  if (keepField &&
+    !computeDisplayFields(unitMesh, iso, voxelSize, amplification, out.Field,
+      amplification ? &out.ModifiedField : nullptr, out.Error))
+  {
+    return out;
+  }
+  out.IsosurfaceSeconds = extractionSeconds + seconds(tf);
+  progressUpdate(progress, 1.0);
+  return out;
+}
+
+} // namespace sdfcage

@@ -1,0 +1,62 @@
+// SDFCage — Core (internal): the OpenVDB part of the pipeline, kept in one translation unit
+// because OpenVDB's mesh tools are slow to compile.
+#pragma once
+
+#include "Envelope/Envelope.h"
+#include "Mesh/Mesh.h"
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace sdfcage
+{
+
+class Progress;
+struct ActivePoints;
+
+struct IsosurfaceOutput
+{
+  /// the isosurface {xi = iso} for each requested adaptivity, triangles (quads split), unit units
+  std::vector<TriangleMesh> Surfaces;
+  ScalarImage Field;      ///< for display: xi on a coarser grid (<= 256 per axis), interior filled
+  ScalarImage ModifiedField; ///< with amplification and keepField: phi * xi on the same grid
+  bool Cancelled = false;
+  std::string Error;
+  double DistanceFieldSeconds = 0.0;
+  double IsosurfaceSeconds = 0.0; ///< the extractions and the display field (not the judge's time)
+  std::size_t ActiveVoxels = 0;
+  std::size_t AmplifiedVoxels = 0; ///< voxels whose value phi changed by more than 1e-3
+  double AmplificationSeconds = 0.0; ///< xi -> phi xi on the grid (part of DistanceFieldSeconds)
+  double AcceptedAdaptivity = 0.0; ///< with a judge: the adaptivity of the accepted surface
+  int Repairs = 0;                 ///< with a judge: re-extractions with a larger no-adaptivity region
+};
+
+/// Judges an extracted surface: true accepts it. Otherwise `repairNear` may receive points (unit-
+/// sphere units) where the surface is wrong: the same adaptivity is tried again with adaptivity
+/// switched off around them (merged polygons are what goes wrong), else the next adaptivity.
+using SurfaceJudge = std::function<bool(const TriangleMesh& surface, double adaptivity, std::vector<Vec3>& repairNear)>;
+
+/// Narrow-band SDF of a closed (possibly self-intersecting) mesh with OpenVDB (sign by flood
+/// fill), wide enough outside for `iso`, then marching-cubes-style extraction at `iso`.
+/// Progress: fractions 0..0.6 for the SDF, 0.6..1 for the surface of the current stage.
+/// With `amplification`, the field is the amplified xi^ = phi * xi of paper eq. 2–3 (outside the
+/// input; inside, xi is kept: its sign is all the isosurface at iso > 0 needs) and the distance
+/// field is computed on amplification->Surface (the refined input, same shape), whose triangles
+/// the closest-triangle ids refer to; `unitInput` is then unused. Adaptivity is switched off
+/// near active points.
+/// Without `judge`, Surfaces holds one surface per adaptivity. With it, the adaptivities are tried
+/// in order (each up to 1 + maxRepairs times, see SurfaceJudge) and Surfaces holds the first
+/// accepted surface only (empty if none).
+IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSize, double iso,
+  bool keepField, Progress* progress, const std::vector<double>& adaptivities = { 0.0 },
+  const ActivePoints* amplification = nullptr, const SurfaceJudge* judge = nullptr, int maxRepairs = 3);
+
+/// For display: xi sampled on a regular grid over the mesh's box plus a margin (spacing at least
+/// `minSpacing`, at most ~256 samples per axis), interior filled, exterior band wide enough to
+/// show the amplification. With `amplification` (non-empty) and `modified`, also phi * xi on the
+/// same grid (amplification->Surface is then the mesh). False with `error` on failure.
+bool computeDisplayFields(const TriangleMesh& unitMesh, double iso, double minSpacing,
+  const ActivePoints* amplification, ScalarImage& field, ScalarImage* modified, std::string& error);
+
+} // namespace sdfcage

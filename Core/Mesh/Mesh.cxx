@@ -1,0 +1,187 @@
+#include "Mesh/Mesh.h"
+
+#include <algorithm>
+#include <numeric>
+#include <unordered_map>
+
+namespace sdfcage
+{
+
+PolygonMesh PolygonMesh::fromTriangles(const TriangleMesh& mesh)
+{
+  PolygonMesh out;
+  out.Points = mesh.Points;
+  out.Offsets.reserve(mesh.Triangles.size() + 1);
+  out.Connectivity.reserve(3 * mesh.Triangles.size());
+  for (const Triangle& t : mesh.Triangles)
+  {
+    out.addCell({ t[0], t[1], t[2] });
+  }
+  return out;
+}
+
+double signedVolume(const TriangleMesh& mesh)
+{
+  double v = 0.0;
+  for (const Triangle& t : mesh.Triangles)
+  {
+    v += mesh.Points[t[0]].dot(mesh.Points[t[1]].cross(mesh.Points[t[2]]));
+  }
+  return v / 6.0;
+}
+
+namespace
+{
+int findRoot(std::vector<int>& parent, int i)
+{
+  while (parent[i] != i)
+  {
+    parent[i] = parent[parent[i]];
+    i = parent[i];
+  }
+  return i;
+}
+} // namespace
+
+int triangleComponents(const TriangleMesh& mesh, std::vector<int>& componentOfTriangle)
+{
+  std::vector<int> parent(mesh.Points.size());
+  std::iota(parent.begin(), parent.end(), 0);
+  for (const Triangle& t : mesh.Triangles)
+  {
+    const int r0 = findRoot(parent, t[0]);
+    for (int k = 1; k < 3; ++k)
+    {
+      const int rk = findRoot(parent, t[k]);
+      if (rk != r0)
+      {
+        parent[rk] = r0;
+      }
+    }
+  }
+  std::vector<int> label(mesh.Points.size(), -1);
+  int count = 0;
+  componentOfTriangle.assign(mesh.Triangles.size(), -1);
+  for (std::size_t f = 0; f < mesh.Triangles.size(); ++f)
+  {
+    const int r = findRoot(parent, mesh.Triangles[f][0]);
+    if (label[r] < 0)
+    {
+      label[r] = count++;
+    }
+    componentOfTriangle[f] = label[r];
+  }
+  return count;
+}
+
+namespace
+{
+std::vector<std::uint64_t> uniqueEdgeKeys(const TriangleMesh& mesh, const std::vector<int>* subset)
+{
+  std::vector<std::uint64_t> keys;
+  auto add = [&](const Triangle& t) {
+    for (int k = 0; k < 3; ++k)
+    {
+      std::uint32_t a = static_cast<std::uint32_t>(t[k]), b = static_cast<std::uint32_t>(t[(k + 1) % 3]);
+      if (a > b)
+      {
+        std::swap(a, b);
+      }
+      keys.push_back((static_cast<std::uint64_t>(a) << 32) | b);
+    }
+  };
+  if (subset)
+  {
+    keys.reserve(3 * subset->size());
+    for (int f : *subset)
+    {
+      add(mesh.Triangles[f]);
+    }
+  }
+  else
+  {
+    keys.reserve(3 * mesh.Triangles.size());
+    for (const Triangle& t : mesh.Triangles)
+    {
+      add(t);
+    }
+  }
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+  return keys;
+}
+} // namespace
+
+long long eulerCharacteristic(const TriangleMesh& mesh)
+{
+  std::vector<char> used(mesh.Points.size(), 0);
+  long long v = 0;
+  for (const Triangle& t : mesh.Triangles)
+  {
+    for (int i : t)
+    {
+      if (!used[i])
+      {
+        used[i] = 1;
+        ++v;
+      }
+    }
+  }
+  const long long e = static_cast<long long>(uniqueEdgeKeys(mesh, nullptr).size());
+  return v - e + static_cast<long long>(mesh.Triangles.size());
+}
+
+int genus(const TriangleMesh& mesh)
+{
+  std::vector<int> comp;
+  const int n = triangleComponents(mesh, comp);
+  // chi summed over components = 2n - 2g
+  const long long chi = eulerCharacteristic(mesh);
+  return static_cast<int>((2LL * n - chi) / 2);
+}
+
+std::array<Vec3, 2> bounds(const TriangleMesh& mesh)
+{
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity());
+  Vec3 hi = -lo;
+  for (const Triangle& t : mesh.Triangles)
+  {
+    for (int i : t)
+    {
+      lo = lo.cwiseMin(mesh.Points[i]);
+      hi = hi.cwiseMax(mesh.Points[i]);
+    }
+  }
+  return { lo, hi };
+}
+
+void removeUnreferencedPoints(TriangleMesh& mesh)
+{
+  std::vector<int> map(mesh.Points.size(), -1);
+  for (const Triangle& t : mesh.Triangles)
+  {
+    for (int i : t)
+    {
+      map[i] = 0;
+    }
+  }
+  int n = 0;
+  for (std::size_t i = 0; i < map.size(); ++i)
+  {
+    if (map[i] == 0)
+    {
+      mesh.Points[n] = mesh.Points[i];
+      map[i] = n++;
+    }
+  }
+  mesh.Points.resize(n);
+  for (Triangle& t : mesh.Triangles)
+  {
+    for (int& i : t)
+    {
+      i = map[i];
+    }
+  }
+}
+
+} // namespace sdfcage

@@ -1,0 +1,1153 @@
+#include "Optimization/Optimization.h"
+
+#include "Spatial/Geometry.h"
+#include "Mesh/Normalization.h"
+#include "Common/Progress.h"
+#include "Quality/Verification.h"
+#include "Spatial/TriangleTree.h"
+#include "Mesh/Validation.h"
+
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+#include <chrono>
+#include <ctime>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+namespace sdfcage
+{
+
+const char* energyName(CageEnergy e)
+{
+  return e == CageEnergy::Spacing ? "Spacing" : "MIPS";
+}
+
+namespace
+{
+
+constexpr double Inf = std::numeric_limits<double>::infinity();
+// Neighbouring cage triangles whose dihedral angle closes below ~18 degrees count as folded (the
+// simplifier's threshold).
+constexpr double FoldCosine = -0.95;
+// Bisection steps of the continuous collision detection when a whole move is not clear.
+constexpr int BisectionSteps = 10;
+// Sufficient-decrease fraction of the line search (Armijo condition).
+constexpr double ArmijoFraction = 0.1;
+// Vertices relocated together at most (a batch of non-overlapping regions).
+constexpr std::size_t MaximumBatch = 256;
+// Backtracking halvings of the line search.
+constexpr int LineSearchTries = 8;
+// The first trial step of the line search, relative to the mean edge length around the vertex.
+constexpr double InitialStep = 0.25;
+// The default clearance at the default isovalue (c / 4), for Clearance <= 0.
+constexpr double DefaultClearance = 0.0025;
+
+double seconds(std::chrono::steady_clock::time_point t0)
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// IPC barrier b(g, d̂) = -(g - d̂)^2 ln(g / d̂) for 0 < g < d̂ (eq. 7), and its derivative.
+double barrier(double g, double dh)
+{
+  if (g >= dh)
+    return 0.0;
+  if (!(g > 0.0))
+    return Inf;
+  return -(g - dh) * (g - dh) * std::log(g / dh);
+}
+double barrierDerivative(double g, double dh)
+{
+  if (g >= dh || !(g > 0.0))
+    return 0.0;
+  return -2.0 * (g - dh) * std::log(g / dh) - (g - dh) * (g - dh) / g;
+}
+
+double triangleQuality(const Vec3& a, const Vec3& b, const Vec3& c)
+{
+  const double area2 = (b - a).cross(c - a).norm();
+  const double s = (b - a).squaredNorm() + (c - b).squaredNorm() + (a - c).squaredNorm();
+  return s > 0 ? 2.0 * std::sqrt(3.0) * area2 / s : 0.0;
+}
+
+/// MIPS with an equilateral reference, sum(l^2) / (2 sqrt(3) A), and its gradient with respect
+/// to the first corner v (the triangle is (v, a, b), counter-clockwise).
+double mips(const Vec3& v, const Vec3& a, const Vec3& b, Vec3* grad)
+{
+  const Vec3 n = (a - v).cross(b - v);
+  const double a2 = n.norm(); // twice the area
+  const double s = (a - v).squaredNorm() + (b - a).squaredNorm() + (v - b).squaredNorm();
+  if (!(a2 > 0))
+    return Inf;
+  const double k = 1.0 / std::sqrt(3.0);
+  const double e = k * s / a2;
+  if (grad)
+  {
+    const Vec3 ds = 2.0 * (2.0 * v - a - b);
+    const Vec3 da2 = (a - b).cross(n / a2);
+    *grad = k * ds / a2 - k * s / (a2 * a2) * da2;
+  }
+  return e;
+}
+
+/// The 3-point degree-2 rule on a triangle: barycentric (2/3, 1/6, 1/6) and its rotations,
+/// weight 1/3 each.
+const double SpacingRule[3][3] = { { 2.0 / 3, 1.0 / 6, 1.0 / 6 }, { 1.0 / 6, 2.0 / 3, 1.0 / 6 },
+  { 1.0 / 6, 1.0 / 6, 2.0 / 3 } };
+
+/// Spacing energy of triangle (v, a, b): A * mean over the rule of (xi - h)^2, and its gradient
+/// with respect to v (xi is 1-Lipschitz with gradient (x - y)/|x - y| outside the input).
+double spacing(const Vec3& v, const Vec3& a, const Vec3& b, const TriangleTree& tree, double h, Vec3* grad)
+{
+  const Vec3 n = (a - v).cross(b - v);
+  const double a2 = n.norm();
+  const double area = 0.5 * a2;
+  double mean = 0.0;
+  Vec3 g = Vec3::Zero();
+  for (const auto& w : SpacingRule)
+  {
+    const Vec3 x = w[0] * v + w[1] * a + w[2] * b;
+    Vec3 y;
+    int tri;
+    double d;
+    if (!tree.closestPoint(x, -1.0, y, tri, d))
+      continue;
+    mean += (d - h) * (d - h) / 3.0;
+    if (grad && d > 0)
+      g += (2.0 * (d - h) * w[0] / 3.0) * (x - y) / d;
+  }
+  if (grad)
+  {
+    const Vec3 dArea = a2 > 0 ? Vec3(0.5 * (a - b).cross(n / a2)) : Vec3(Vec3::Zero());
+    *grad = dArea * mean + area * g;
+  }
+  return area * mean;
+}
+
+double triangleEnergy(const Vec3& a, const Vec3& b, const Vec3& c, const TriangleTree& tree, const OptimizeOptions& o)
+{
+  return o.Energy == CageEnergy::Spacing ? spacing(a, b, c, tree, o.TargetSpacing, nullptr) : mips(a, b, c, nullptr);
+}
+
+/// A bounding sphere of a triangle (centroid, farthest corner): distances between two
+/// triangles are at least |c1 - c2| - r1 - r2.
+struct Sphere
+{
+  Vec3 C;
+  double R;
+};
+Sphere boundingSphere(const Vec3& a, const Vec3& b, const Vec3& c)
+{
+  const Vec3 m = (a + b + c) / 3.0;
+  return { m, std::sqrt(std::max({ (a - m).squaredNorm(), (b - m).squaredNorm(), (c - m).squaredNorm() })) };
+}
+
+std::uint64_t edgeKey(int a, int b)
+{
+  if (a > b)
+    std::swap(a, b);
+  return (static_cast<std::uint64_t>(a) << 32) | static_cast<std::uint32_t>(b);
+}
+
+/// The optimizer's working state: the cage with vertex-triangle adjacency and cached boxes.
+class Optimizer
+{
+public:
+  Optimizer(const TriangleMesh& cage, const TriangleMesh& input, const TriangleTree& tree, const OptimizeOptions& o,
+    double clearance, double selfClearance, Progress* progress)
+    : Input(input)
+    , Tree(tree)
+    , Opt(o)
+    , Delta(clearance)
+    , SelfDelta(selfClearance)
+    , Prog(progress)
+  {
+    P = cage.Points;
+    T = cage.Triangles;
+    VT.assign(P.size(), {});
+    for (std::size_t f = 0; f < T.size(); ++f)
+      for (int v : T[f])
+        VT[v].push_back(static_cast<int>(f));
+    Lo.resize(T.size());
+    Hi.resize(T.size());
+    std::vector<int> component;
+    const int components = triangleComponents(input, component);
+    std::vector<char> seen(static_cast<std::size_t>(std::max(0, components)), 0);
+    for (std::size_t f = 0; f < input.Triangles.size(); ++f)
+      if (!seen[component[f]])
+      {
+        seen[component[f]] = 1;
+        Representatives.push_back(input.Points[input.Triangles[f][0]]);
+      }
+    for (std::size_t f = 0; f < T.size(); ++f)
+      updateBox(static_cast<int>(f));
+  }
+
+  TriangleMesh mesh() const
+  {
+    TriangleMesh m;
+    m.Points = P;
+    m.Triangles = T;
+    return m;
+  }
+
+  /// One relocation pass over every vertex. Returns false when cancelled.
+  ///
+  /// Vertices are relocated in batches whose regions do not overlap, the batches in parallel. The
+  /// region of a vertex is the box of its one-ring grown by everything its descent steps can touch
+  /// or read: its whole motion (DescentSteps trial steps of at most `reach`), the radius within
+  /// which cage triangles are gathered, and the self clearance. A vertex of a batch therefore
+  /// never reads a position another vertex of the batch writes (cage triangle boxes are updated
+  /// between batches), so a batch gives the same result in any order and on any number of threads.
+  /// Batches take the pending vertices in index order, deferring those that overlap.
+  bool relocationPass(OptimizeResult& r, double progressBegin, double progressEnd)
+  {
+    const int steps = std::max(1, Opt.DescentSteps);
+    const double dh = std::max(0.0, Opt.BarrierDistance);
+    std::vector<int> pending, next, batch;
+    for (std::size_t v = 0; v < P.size(); ++v)
+      if (!VT[v].empty())
+        pending.push_back(static_cast<int>(v));
+    const std::size_t total = pending.size();
+    std::vector<double> reach(P.size(), 0.0);
+    std::vector<Vec3> boxLo, boxHi;
+    std::vector<int> outcomeMoves, outcomeRejected;
+    std::size_t done = 0;
+    while (!pending.empty())
+    {
+      if (Prog && Prog->update(progressBegin + (progressEnd - progressBegin) * double(done) / double(std::max<std::size_t>(1, total))))
+        return false;
+      batch.clear();
+      next.clear();
+      boxLo.clear();
+      boxHi.clear();
+      for (int v : pending)
+      {
+        Vec3 lo = Vec3::Constant(Inf), hi = -lo;
+        double edgeSum = 0.0;
+        for (int f : VT[v])
+          for (int w : T[f])
+          {
+            lo = lo.cwiseMin(P[w]);
+            hi = hi.cwiseMax(P[w]);
+            edgeSum += (P[w] - P[v]).norm(); // each neighbour twice, v itself adds 0
+          }
+        reach[v] = InitialStep * edgeSum / (2.0 * double(VT[v].size()));
+        const double grow = steps * reach[v] + SelfDelta + dh + reach[v] + SelfDelta;
+        lo -= Vec3::Constant(grow);
+        hi += Vec3::Constant(grow);
+        bool overlaps = batch.size() >= MaximumBatch;
+        for (std::size_t i = 0; i < batch.size() && !overlaps; ++i)
+          overlaps = !((boxLo[i].array() > hi.array()).any() || (boxHi[i].array() < lo.array()).any());
+        if (overlaps)
+        {
+          next.push_back(v);
+          continue;
+        }
+        batch.push_back(v);
+        boxLo.push_back(lo);
+        boxHi.push_back(hi);
+      }
+      outcomeMoves.assign(batch.size(), 0);
+      outcomeRejected.assign(batch.size(), 0);
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, batch.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
+        for (std::size_t i = range.begin(); i != range.end(); ++i)
+        {
+          const int v = batch[i];
+          for (int step = 0; step < steps; ++step)
+          {
+            const int outcome = descend(v, reach[v]);
+            if (outcome > 0)
+              ++outcomeMoves[i];
+            else
+            {
+              if (outcome < 0)
+                ++outcomeRejected[i];
+              break;
+            }
+          }
+        }
+      });
+      for (std::size_t i = 0; i < batch.size(); ++i)
+      {
+        r.Moves += outcomeMoves[i];
+        r.RejectedMoves += outcomeRejected[i];
+        if (outcomeMoves[i] > 0)
+          for (int f : VT[batch[i]])
+            updateBox(f);
+      }
+      done += batch.size();
+      ++r.Batches;
+      pending.swap(next);
+    }
+    return true;
+  }
+
+  /// One pass over the edges: flip where E_quality drops and every constraint holds.
+  bool flipPass(OptimizeResult& r)
+  {
+    std::vector<std::uint64_t> edges;
+    for (const Triangle& t : T)
+      for (int k = 0; k < 3; ++k)
+        if (t[k] < t[(k + 1) % 3])
+          edges.push_back(edgeKey(t[k], t[(k + 1) % 3]));
+    std::sort(edges.begin(), edges.end());
+    for (std::size_t i = 0; i < edges.size(); ++i)
+    {
+      if (i % 64 == 0 && progressCancelled(Prog))
+        return false;
+      const int a = static_cast<int>(edges[i] >> 32), b = static_cast<int>(edges[i] & 0xFFFFFFFFu);
+      const int outcome = tryFlip(a, b);
+      if (outcome > 0)
+        ++r.Flips;
+      else if (outcome < 0)
+        ++r.RejectedFlips;
+    }
+    return true;
+  }
+
+  // ---- continuous collision detection (also used through collisionFreeFraction) ---------------
+
+  /// Barrier primitives, each counted once: triangles (vs the point v), edges (vs the edges
+  /// (v, w)) and points (vs the ring triangles), each with the distance its pair must keep.
+  struct Primitives
+  {
+    std::vector<std::array<Vec3, 3>> Tri;
+    std::vector<Sphere> TriSpheres;
+    std::vector<double> TriMargin;
+    std::vector<std::array<Vec3, 2>> Edge;
+    std::vector<double> EdgeMargin;
+    std::vector<Vec3> Point;
+    std::vector<double> PointMargin;
+    void clear()
+    {
+      Tri.clear();
+      TriSpheres.clear();
+      TriMargin.clear();
+      Edge.clear();
+      EdgeMargin.clear();
+      Point.clear();
+      PointMargin.clear();
+    }
+  };
+
+  /// Everything near vertex v that a move of length up to `reach` can involve. The input is not
+  /// gathered: its distances come from the tree at each position.
+  struct Local
+  {
+    int V = -1;
+    Vec3 P0;
+    std::vector<int> Ring;           ///< triangles around v
+    std::vector<std::array<int, 3>> RingIds; ///< rotated so v comes first
+    std::vector<int> CageTris;       ///< other cage triangles within selfδ + d̂ + reach
+    std::vector<Sphere> CageSpheres;
+    /// Lower bounds on the distance at P0 between ring triangle i and cage candidate j (exact
+    /// where it could matter, index i * count + j); infinite for pairs sharing a vertex.
+    std::vector<double> CageD0;
+    /// Per ring triangle, a lower bound on its distance to the input at P0 (δ + d̂ or 0): the
+    /// input is clear of the ring at q when this minus |q - P0| is large enough.
+    std::vector<double> InputD0;
+    /// Cage barrier primitives: those of candidates sharing no vertex with the closed star of v.
+    Primitives CageBarrier;
+    double MeanEdge = 0.0;
+  };
+
+  void gather(int v, double reach, Local& L) const
+  {
+    L = Local();
+    L.V = v;
+    L.P0 = P[v];
+    L.Ring = VT[v];
+    std::vector<int> star{ v };
+    double edgeSum = 0.0;
+    for (int f : L.Ring)
+    {
+      const Triangle& t = T[f];
+      int k = 0;
+      while (t[k] != v)
+        ++k;
+      L.RingIds.push_back({ v, t[(k + 1) % 3], t[(k + 2) % 3] });
+      star.push_back(t[(k + 1) % 3]);
+      edgeSum += (P[t[(k + 1) % 3]] - P[v]).norm();
+    }
+    std::sort(star.begin(), star.end());
+    star.erase(std::unique(star.begin(), star.end()), star.end());
+    L.MeanEdge = edgeSum / std::max<std::size_t>(1, L.Ring.size());
+    auto inStar = [&](int w) { return std::binary_search(star.begin(), star.end(), w); };
+
+    const double dh = std::max(0.0, Opt.BarrierDistance);
+    const double cageRadius = SelfDelta + dh + reach;
+    Vec3 ringLo = Vec3::Constant(Inf), ringHi = -ringLo;
+    for (const auto& ids : L.RingIds)
+    {
+      const Vec3 pts[3] = { P[ids[0]], P[ids[1]], P[ids[2]] };
+      for (const Vec3& q : pts)
+      {
+        ringLo = ringLo.cwiseMin(q);
+        ringHi = ringHi.cwiseMax(q);
+      }
+    }
+    const Vec3 lo = ringLo - Vec3::Constant(cageRadius), hi = ringHi + Vec3::Constant(cageRadius);
+    const std::size_t nr = L.RingIds.size();
+    std::vector<Sphere> ringSpheres(nr);
+    for (std::size_t i = 0; i < nr; ++i)
+      ringSpheres[i] = boundingSphere(P[L.RingIds[i][0]], P[L.RingIds[i][1]], P[L.RingIds[i][2]]);
+    // the lower bound of a pair is made exact only when it could limit a move of `reach`
+    auto lowerBound = [&](std::size_t i, const Vec3 q[3], const Sphere& sq, double margin) {
+      const double lb = (sq.C - ringSpheres[i].C).norm() - sq.R - ringSpheres[i].R;
+      if (lb - margin >= reach + dh)
+        return lb;
+      const Vec3 rp[3] = { P[L.RingIds[i][0]], P[L.RingIds[i][1]], P[L.RingIds[i][2]] };
+      return std::sqrt(triangleTriangleDistance2(rp, q));
+    };
+    std::vector<double> d0(nr);
+    for (std::size_t f = 0; f < T.size(); ++f)
+    {
+      if ((Lo[f].array() > hi.array()).any() || (Hi[f].array() < lo.array()).any())
+        continue;
+      const Triangle& t = T[f];
+      if (t[0] == v || t[1] == v || t[2] == v)
+        continue;
+      const Vec3 pts[3] = { P[t[0]], P[t[1]], P[t[2]] };
+      const Sphere sf = boundingSphere(pts[0], pts[1], pts[2]);
+      bool near = false;
+      for (std::size_t i = 0; i < nr; ++i)
+      {
+        const auto& ids = L.RingIds[i];
+        const bool shares = t[0] == ids[1] || t[0] == ids[2] || t[1] == ids[1] || t[1] == ids[2] ||
+          t[2] == ids[1] || t[2] == ids[2];
+        d0[i] = lowerBound(i, pts, sf, SelfDelta);
+        near = near || d0[i] < cageRadius;
+        if (shares)
+          d0[i] = Inf;
+      }
+      if (near)
+      {
+        L.CageTris.push_back(static_cast<int>(f));
+        L.CageSpheres.push_back(sf);
+        L.CageD0.insert(L.CageD0.end(), d0.begin(), d0.end());
+      }
+    }
+    const std::size_t nc = L.CageTris.size();
+    // CageD0 was filled candidate-major: transpose to ring-major
+    std::vector<double> cd(nr * nc);
+    for (std::size_t j = 0; j < nc; ++j)
+      for (std::size_t i = 0; i < nr; ++i)
+        cd[i * nc + j] = L.CageD0[j * nr + i];
+    L.CageD0.swap(cd);
+    for (std::size_t i = 0; i < nr; ++i)
+    {
+      const Vec3 rp[3] = { P[L.RingIds[i][0]], P[L.RingIds[i][1]], P[L.RingIds[i][2]] };
+      // a cheap certificate (the query stops at the first triangle closer than the limit)
+      const double limit = Delta + dh;
+      L.InputD0.push_back(Tree.anyCloserThan(rp, limit) ? 0.0 : limit);
+    }
+    // cage barrier primitives
+    if (!(dh > 0))
+      return;
+    std::vector<int> far;
+    for (int f : L.CageTris)
+    {
+      const Triangle& t = T[f];
+      if (!inStar(t[0]) && !inStar(t[1]) && !inStar(t[2]))
+        far.push_back(f);
+    }
+    primitives(far, T, P, SelfDelta, L.CageBarrier);
+    // pairs already closer than the self clearance keep half their distance (see relaxed())
+    Primitives& b = L.CageBarrier;
+    for (std::size_t i = 0; i < b.Tri.size(); ++i)
+      b.TriMargin[i] = relaxed((L.P0 - closestPointOnTriangle(L.P0, b.Tri[i][0], b.Tri[i][1], b.Tri[i][2])).norm());
+    for (std::size_t i = 0; i < b.Edge.size(); ++i)
+    {
+      double d = Inf, s, t;
+      for (const auto& ids : L.RingIds)
+        d = std::min(d, std::sqrt(segmentSegmentClosest(L.P0, P[ids[1]], b.Edge[i][0], b.Edge[i][1], s, t)));
+      b.EdgeMargin[i] = relaxed(d);
+    }
+    for (std::size_t i = 0; i < b.Point.size(); ++i)
+    {
+      double d = Inf;
+      for (const auto& ids : L.RingIds)
+        d = std::min(d, (b.Point[i] - closestPointOnTriangle(b.Point[i], L.P0, P[ids[1]], P[ids[2]])).norm());
+      b.PointMargin[i] = relaxed(d);
+    }
+  }
+
+  /// Barrier primitives of the triangles `tris` of a mesh (triangles, points): every triangle,
+  /// every edge and every point once.
+  void primitives(const std::vector<int>& tris, const std::vector<Triangle>& triangles,
+    const std::vector<Vec3>& points, double margin, Primitives& out) const
+  {
+    out.clear();
+    Work& w = work();
+    std::vector<std::uint64_t>& edges = w.Edges;
+    std::vector<int>& ids = w.Points;
+    edges.clear();
+    ids.clear();
+    for (int f : tris)
+    {
+      const Triangle& t = triangles[f];
+      out.Tri.push_back({ points[t[0]], points[t[1]], points[t[2]] });
+      out.TriSpheres.push_back(boundingSphere(points[t[0]], points[t[1]], points[t[2]]));
+      out.TriMargin.push_back(margin);
+      for (int k = 0; k < 3; ++k)
+      {
+        edges.push_back(edgeKey(t[k], t[(k + 1) % 3]));
+        ids.push_back(t[k]);
+      }
+    }
+    std::sort(edges.begin(), edges.end());
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    std::sort(ids.begin(), ids.end());
+    ids.erase(std::unique(ids.begin(), ids.end()), ids.end());
+    for (std::uint64_t e : edges)
+    {
+      out.Edge.push_back({ points[static_cast<int>(e >> 32)], points[static_cast<int>(e & 0xFFFFFFFFu)] });
+      out.EdgeMargin.push_back(margin);
+    }
+    for (int q : ids)
+    {
+      out.Point.push_back(points[q]);
+      out.PointMargin.push_back(margin);
+    }
+  }
+
+  /// The distance a pair of vertex-disjoint cage triangles must keep: the self clearance, or half
+  /// their distance before the move when they were already closer (a given cage, or the dense
+  /// envelope's leftovers, may have such pairs; they may move, but never touch).
+  double relaxed(double before) const { return before >= SelfDelta ? SelfDelta : 0.5 * before; }
+
+  /// Is the straight move of v from P0 to q collision-free? The ring triangle (v, a, b) sweeps
+  /// exactly the tetrahedron conv(P0, q, a, b) (a point of it is (P0 + s (q - P0)) weighted with
+  /// a and b). So no pair comes closer than its margin during the move iff no input triangle and
+  /// no cage triangle sharing no vertex with (v, a, b) comes closer than its margin to the
+  /// tetrahedron: that is, to one of its faces (the face (P0, a, b) is the starting triangle,
+  /// already clear), or lies wholly inside it (then its component's representative point, or for
+  /// the cage its corners, are inside). Exact-in-effect distances (the same double-precision
+  /// triangle-triangle distances as everywhere else).
+  bool sweepClear(const Local& L, const Vec3& q) const
+  {
+    const double moved = (q - L.P0).norm();
+    const std::size_t nc = L.CageTris.size();
+    for (std::size_t r = 0; r < L.RingIds.size(); ++r)
+    {
+      const auto& ids = L.RingIds[r];
+      const Vec3& a = P[ids[1]];
+      const Vec3& b = P[ids[2]];
+      const Vec3 faces[3][3] = { { q, a, b }, { L.P0, q, a }, { L.P0, b, q } };
+      // the tetrahedron lies within `moved` of the starting triangle: if that is far enough from
+      // the input, neither a face nor a whole component can come closer than Delta
+      const bool inputFar = L.InputD0[r] - moved >= Delta;
+      for (const auto& f : faces)
+        if (!inputFar && Tree.anyCloserThan(f, Delta))
+          return false;
+      const double volume = (q - L.P0).dot((a - L.P0).cross(b - L.P0));
+      const bool solid = std::abs(volume) > 1e-14 * std::pow(std::max({ moved, (a - L.P0).norm(), (b - L.P0).norm() }), 3);
+      auto inside = [&](const Vec3& x) {
+        if (!solid)
+          return false;
+        const double s0 = (a - x).dot((b - x).cross(q - x)); // opposite P0
+        const double s1 = (L.P0 - x).dot((b - x).cross(a - x)); // opposite q
+        const double s2 = (L.P0 - x).dot((q - x).cross(b - x)); // opposite a
+        const double s3 = (L.P0 - x).dot((a - x).cross(q - x)); // opposite b
+        return (s0 >= 0 && s1 >= 0 && s2 >= 0 && s3 >= 0) || (s0 <= 0 && s1 <= 0 && s2 <= 0 && s3 <= 0);
+      };
+      for (const Vec3& x : Representatives)
+        if (!inputFar && inside(x))
+          return false;
+      for (std::size_t i = 0; i < nc; ++i)
+      {
+        // the tetrahedron lies within `moved` of the starting triangle; also skips pairs
+        // sharing a vertex (infinite bound)
+        const double d0 = L.CageD0[r * nc + i];
+        const double margin = relaxed(d0);
+        if (d0 - moved - margin >= 0)
+          continue;
+        const Triangle& t = T[L.CageTris[i]];
+        const Vec3 c[3] = { P[t[0]], P[t[1]], P[t[2]] };
+        for (const auto& f : faces)
+          if (triangleTriangleDistance2(f, c) < margin * margin)
+            return false;
+        for (const Vec3& x : c)
+          if (inside(x))
+            return false;
+      }
+    }
+    return true;
+  }
+
+  /// The largest fraction t of the move (to 1/1024) for which the move to P0 + t move is
+  /// collision-free: the whole move if it is, else a bisection (a fraction is clear iff its
+  /// tetrahedra are, and they grow with t, so clear fractions form an interval [0, t*]).
+  double advance(const Local& L, const Vec3& move) const
+  {
+    if (!(move.norm() > 0) || sweepClear(L, L.P0 + move))
+      return 1.0;
+    double lo = 0.0, hi = 1.0;
+    for (int k = 0; k < BisectionSteps; ++k)
+    {
+      const double mid = 0.5 * (lo + hi);
+      if (sweepClear(L, L.P0 + mid * move))
+        lo = mid;
+      else
+        hi = mid;
+    }
+    return lo;
+  }
+
+  /// Adds the barrier of the pairs between the primitives and the ring of v at p to B (and its
+  /// gradient with respect to p to gb).
+  void barrierTerms(const Local& L, const Primitives& prims, const Vec3& p, double dh, bool withGradient,
+    double& B, Vec3& gb) const
+  {
+    auto add = [&](double d, double margin, const Vec3& dddp) {
+      const double gap = d - margin;
+      if (gap >= dh)
+        return;
+      B += barrier(gap, dh);
+      if (withGradient)
+        gb += barrierDerivative(gap, dh) * dddp;
+    };
+    // point v vs triangles
+    for (std::size_t i = 0; i < prims.Tri.size(); ++i)
+    {
+      const auto& q = prims.Tri[i];
+      if ((p - prims.TriSpheres[i].C).norm() - prims.TriSpheres[i].R - prims.TriMargin[i] >= dh)
+        continue;
+      const Vec3 y = closestPointOnTriangle(p, q[0], q[1], q[2]);
+      const double d = (p - y).norm();
+      add(d, prims.TriMargin[i], d > 0 ? Vec3((p - y) / d) : Vec3(Vec3::Zero()));
+    }
+    // edges (v, w) vs edges; each edge (v, w) is the first edge of exactly one ring triangle
+    for (const auto& ids : L.RingIds)
+    {
+      const Vec3& w = P[ids[1]];
+      const Vec3 mid = 0.5 * (p + w);
+      const double half = 0.5 * (w - p).norm();
+      for (std::size_t i = 0; i < prims.Edge.size(); ++i)
+      {
+        const auto& e = prims.Edge[i];
+        if ((0.5 * (e[0] + e[1]) - mid).norm() - half - 0.5 * (e[1] - e[0]).norm() - prims.EdgeMargin[i] >= dh)
+          continue;
+        double s, t;
+        const double d = std::sqrt(segmentSegmentClosest(p, w, e[0], e[1], s, t));
+        const Vec3 x = p + s * (w - p), y = e[0] + t * (e[1] - e[0]);
+        add(d, prims.EdgeMargin[i], d > 0 ? Vec3((1.0 - s) * (x - y) / d) : Vec3(Vec3::Zero()));
+      }
+    }
+    // ring triangles vs points
+    for (const auto& ids : L.RingIds)
+    {
+      const Vec3& a = P[ids[1]];
+      const Vec3& b = P[ids[2]];
+      const double full = (a - p).cross(b - p).norm();
+      const Sphere sr = boundingSphere(p, a, b);
+      for (std::size_t i = 0; i < prims.Point.size(); ++i)
+      {
+        const Vec3& q = prims.Point[i];
+        if ((q - sr.C).norm() - sr.R - prims.PointMargin[i] >= dh)
+          continue;
+        const Vec3 x = closestPointOnTriangle(q, p, a, b);
+        const double d = (x - q).norm();
+        const double wv = full > 0 ? (a - x).cross(b - x).norm() / full : 1.0 / 3.0;
+        add(d, prims.PointMargin[i], d > 0 ? Vec3(wv * (x - q) / d) : Vec3(Vec3::Zero()));
+      }
+    }
+  }
+
+  // ---- energy of one vertex -------------------------------------------------------------------
+
+  double vertexEnergy(const Local& L, const Vec3& p, Vec3* grad) const
+  {
+    double e = 0.0;
+    Vec3 g = Vec3::Zero();
+    Vec3 gt;
+    for (const auto& ids : L.RingIds)
+    {
+      const Vec3& a = P[ids[1]];
+      const Vec3& b = P[ids[2]];
+      e += Opt.Energy == CageEnergy::Spacing ? spacing(p, a, b, Tree, Opt.TargetSpacing, grad ? &gt : nullptr)
+                                             : mips(p, a, b, grad ? &gt : nullptr);
+      if (grad)
+        g += gt;
+    }
+    const double dh = Opt.BarrierDistance;
+    const double lambda = Opt.BarrierWeight;
+    if (dh > 0 && lambda > 0)
+    {
+      double B = 0.0;
+      Vec3 gb = Vec3::Zero();
+      barrierTerms(L, L.CageBarrier, p, dh, grad != nullptr, B, gb);
+      // the input: only triangles within δ + d̂ of the ring at p can give a non-zero term
+      Work& w = work();
+      std::vector<int>& InputScratch = w.InputIds;
+      InputScratch.clear();
+      const double moved = (p - L.P0).norm();
+      for (std::size_t r = 0; r < L.RingIds.size(); ++r)
+      {
+        if (L.InputD0[r] - moved >= Delta + dh) // no input within the barrier's reach
+          continue;
+        const Vec3 rp[3] = { p, P[L.RingIds[r][1]], P[L.RingIds[r][2]] };
+        Tree.trianglesWithin(rp, Delta + dh, InputScratch);
+      }
+      if (!InputScratch.empty())
+      {
+        std::sort(InputScratch.begin(), InputScratch.end());
+        InputScratch.erase(std::unique(InputScratch.begin(), InputScratch.end()), InputScratch.end());
+        primitives(InputScratch, Input.Triangles, Input.Points, Delta, w.InputBarrier);
+        barrierTerms(L, w.InputBarrier, p, dh, grad != nullptr, B, gb);
+      }
+      e += lambda * B;
+      g += lambda * gb;
+    }
+    if (grad)
+      *grad = g;
+    return e;
+  }
+
+  // ---- static acceptance test ---------------------------------------------------------------
+
+  /// The ring of v at p: no needle or flip, clearance to the input (exact distances through the
+  /// tree), no conflict with any other cage triangle (the simplifier's test).
+  /// `inputChecked`: the input clearance of the ring at p was just established by sweepClear()
+  /// (its tetrahedra have the ring at p as a face, tested with the same anyCloserThan).
+  bool ringAcceptable(const Local& L, const Vec3& p, bool inputChecked) const
+  {
+    Work& w = work();
+    w.LastVeto = Veto::Shape;
+    const int n = static_cast<int>(L.RingIds.size());
+    std::vector<std::array<Vec3, 3>> pts(n);
+    for (int i = 0; i < n; ++i)
+    {
+      const auto& ids = L.RingIds[i];
+      pts[i] = { p, P[ids[1]], P[ids[2]] };
+      const Vec3 before = (P[ids[1]] - L.P0).cross(P[ids[2]] - L.P0);
+      const Vec3 after = (pts[i][1] - p).cross(pts[i][2] - p);
+      if (!(after.dot(before) > 0))
+        return false;
+      const double q0 = triangleQuality(L.P0, P[ids[1]], P[ids[2]]);
+      if (triangleQuality(p, P[ids[1]], P[ids[2]]) < std::min(Opt.MinimumTriangleQuality, q0))
+        return false;
+      if (!inputChecked && Tree.anyCloserThan(pts[i].data(), Delta))
+        return false;
+    }
+    w.LastVeto = Veto::Self;
+    for (int i = 0; i < n; ++i)
+      for (int j = i + 1; j < n; ++j)
+        if (trianglesConflict(L.RingIds[i].data(), pts[i].data(), L.RingIds[j].data(), pts[j].data(), SelfDelta, FoldCosine))
+          return false;
+    for (int i = 0; i < n; ++i)
+    {
+      const Vec3 lo = pts[i][0].cwiseMin(pts[i][1]).cwiseMin(pts[i][2]) - Vec3::Constant(SelfDelta);
+      const Vec3 hi = pts[i][0].cwiseMax(pts[i][1]).cwiseMax(pts[i][2]) + Vec3::Constant(SelfDelta);
+      const Vec3 before[3] = { L.P0, P[L.RingIds[i][1]], P[L.RingIds[i][2]] };
+      if (!othersClear(L.RingIds[i].data(), pts[i].data(), lo, hi, L.Ring.data(), L.Ring.size(), before))
+        return false;
+    }
+    return true;
+  }
+
+  /// No cage triangle other than `skip` conflicts with the triangle (ids, pts) of box [lo, hi].
+  /// `before` (optional): the same triangle before the change, for the relaxed margin of pairs
+  /// that were already closer than the self clearance.
+  bool othersClear(const int ids[3], const Vec3 pts[3], const Vec3& lo, const Vec3& hi, const int* skip,
+    std::size_t skipCount, const Vec3* before = nullptr) const
+  {
+    for (std::size_t f = 0; f < T.size(); ++f)
+    {
+      if ((Lo[f].array() > hi.array()).any() || (Hi[f].array() < lo.array()).any())
+        continue;
+      if (std::find(skip, skip + skipCount, static_cast<int>(f)) != skip + skipCount)
+        continue;
+      const Triangle& t = T[f];
+      const int tid[3] = { t[0], t[1], t[2] };
+      const Vec3 tp[3] = { P[t[0]], P[t[1]], P[t[2]] };
+      bool disjoint = true;
+      for (int a : tid)
+        disjoint = disjoint && a != ids[0] && a != ids[1] && a != ids[2];
+      if (disjoint)
+      {
+        // disjoint triangles whose bounding spheres are farther apart than SelfDelta cannot conflict
+        const Sphere s1 = boundingSphere(pts[0], pts[1], pts[2]), s2 = boundingSphere(tp[0], tp[1], tp[2]);
+        if ((s1.C - s2.C).norm() - s1.R - s2.R >= SelfDelta)
+          continue;
+      }
+      if (trianglesConflict(ids, pts, tid, tp, SelfDelta, FoldCosine))
+      {
+        if (!disjoint || !before)
+          return false;
+        const double d0 = std::sqrt(triangleTriangleDistance2(before, tp));
+        const double d2 = triangleTriangleDistance2(pts, tp);
+        if (d0 >= SelfDelta || d2 == 0.0 || d2 < relaxed(d0) * relaxed(d0))
+          return false;
+      }
+    }
+    return true;
+  }
+
+  // ---- one descent step at v: 1 moved, 0 converged (no descent direction), -1 no acceptable step
+  /// `reach`: the first trial step (the later ones are shorter, so gathering within it covers
+  /// them all). The caller updates the boxes of the ring's triangles after a move.
+  int descend(int v, double reach)
+  {
+    Work& w = work();
+    Local& L = w.L;
+    gather(v, reach, L);
+    Vec3 g;
+    const double e0 = vertexEnergy(L, L.P0, &g);
+    const double gn = g.norm();
+    if (!std::isfinite(e0) || !(gn > 0) || !std::isfinite(gn))
+      return std::isfinite(e0) ? 0 : -1;
+    const Vec3 dir = -g / gn;
+    double step = reach;
+    Veto worst = Veto::Energy; // the last reason a trial step failed
+    for (int k = 0; k < LineSearchTries; ++k, step *= 0.5)
+    {
+      // energy first (cheaper than the collision test), then the collision-free fraction
+      const Vec3 move = step * dir;
+      Vec3 p = L.P0 + move;
+      // sufficient decrease (Armijo): at least a fraction of what the slope promises
+      const double wanted = e0 - ArmijoFraction * step * gn;
+      if (!(vertexEnergy(L, p, nullptr) <= wanted))
+      {
+        worst = Veto::Energy;
+        continue;
+      }
+      const double t = advance(L, move);
+      if (!(t > 0))
+      {
+        ++w.Counts[static_cast<int>(Veto::Collision)];
+        return -1;
+      }
+      if (t < 1.0)
+      {
+        p = L.P0 + t * move;
+        if (!(vertexEnergy(L, p, nullptr) <= e0 - ArmijoFraction * t * step * gn))
+        {
+          worst = Veto::Collision;
+          continue;
+        }
+      }
+      if (!ringAcceptable(L, p, true))
+      {
+        worst = w.LastVeto;
+        continue;
+      }
+      P[v] = p;
+      return 1;
+    }
+    ++w.Counts[static_cast<int>(worst)];
+    return -1;
+  }
+
+  /// Why descent steps failed (the reason of their last trial): energy not lowered, collision
+  /// (CCD), shape (flip or needle), self-intersection (static test).
+  enum class Veto
+  {
+    Energy = 0,
+    Collision,
+    Shape,
+    Self
+  };
+  /// Per-thread scratch of the relocation (the const queries write only here).
+  struct Work
+  {
+    Local L;
+    std::vector<int> InputIds;
+    Primitives InputBarrier;
+    std::vector<std::uint64_t> Edges;
+    std::vector<int> Points;
+    Veto LastVeto = Veto::Shape;
+    long long Counts[4] = { 0, 0, 0, 0 };
+  };
+  Work& work() const { return Works.local(); }
+  /// The veto counts summed over the threads.
+  void counts(long long out[4]) const
+  {
+    for (int k = 0; k < 4; ++k)
+      out[k] = 0;
+    for (const Work& w : Works)
+      for (int k = 0; k < 4; ++k)
+        out[k] += w.Counts[k];
+  }
+
+  // ---- edge flip of (a, b): 1 flipped, 0 not worth it / not allowed topologically, -1 vetoed
+  int tryFlip(int a, int b)
+  {
+    int f1 = -1, f2 = -1, c = -1, d = -1;
+    for (int f : VT[a])
+    {
+      const Triangle& t = T[f];
+      for (int k = 0; k < 3; ++k)
+      {
+        if (t[k] == a && t[(k + 1) % 3] == b)
+        {
+          f1 = f;
+          c = t[(k + 2) % 3];
+        }
+        if (t[k] == b && t[(k + 1) % 3] == a)
+        {
+          f2 = f;
+          d = t[(k + 2) % 3];
+        }
+      }
+    }
+    if (f1 < 0 || f2 < 0 || c == d || VT[a].size() <= 3 || VT[b].size() <= 3)
+      return 0;
+    for (int f : VT[c]) // the new edge must not exist already (manifold)
+      for (int w : T[f])
+        if (w == d)
+          return 0;
+    const Triangle n1{ c, a, d }, n2{ d, b, c };
+    const double before = triangleEnergy(P[a], P[b], P[c], Tree, Opt) + triangleEnergy(P[b], P[a], P[d], Tree, Opt);
+    const double after = triangleEnergy(P[c], P[a], P[d], Tree, Opt) + triangleEnergy(P[d], P[b], P[c], Tree, Opt);
+    if (!(after < before - 1e-12 * std::abs(before)))
+      return 0;
+    const double qmin = std::min({ Opt.MinimumTriangleQuality, triangleQuality(P[a], P[b], P[c]),
+      triangleQuality(P[b], P[a], P[d]) });
+    const Vec3 nOld = (P[b] - P[a]).cross(P[c] - P[a]).normalized() + (P[a] - P[b]).cross(P[d] - P[b]).normalized();
+    const int ids1[3] = { c, a, d }, ids2[3] = { d, b, c };
+    const Vec3 p1[3] = { P[c], P[a], P[d] }, p2[3] = { P[d], P[b], P[c] };
+    for (const Vec3* p : { p1, p2 })
+    {
+      if (triangleQuality(p[0], p[1], p[2]) < qmin)
+        return -1;
+      if (!((p[1] - p[0]).cross(p[2] - p[0]).dot(nOld) > 0))
+        return -1;
+      if (Tree.anyCloserThan(p, Delta))
+        return -1;
+    }
+    if (trianglesConflict(ids1, p1, ids2, p2, SelfDelta, FoldCosine))
+      return -1;
+    const int skip[2] = { f1, f2 };
+    for (int i = 0; i < 2; ++i)
+    {
+      const int* ids = i == 0 ? ids1 : ids2;
+      const Vec3* p = i == 0 ? p1 : p2;
+      const Vec3 lo = p[0].cwiseMin(p[1]).cwiseMin(p[2]) - Vec3::Constant(SelfDelta);
+      const Vec3 hi = p[0].cwiseMax(p[1]).cwiseMax(p[2]) + Vec3::Constant(SelfDelta);
+      if (!othersClear(ids, p, lo, hi, skip, 2))
+        return -1;
+    }
+    T[f1] = n1;
+    T[f2] = n2;
+    auto drop = [&](int v, int f) {
+      auto& l = VT[v];
+      l.erase(std::remove(l.begin(), l.end(), f), l.end());
+    };
+    drop(a, f2);
+    drop(b, f1);
+    VT[c].push_back(f2);
+    VT[d].push_back(f1);
+    updateBox(f1);
+    updateBox(f2);
+    return 1;
+  }
+
+  void updateBox(int f)
+  {
+    const Triangle& t = T[f];
+    Lo[f] = P[t[0]].cwiseMin(P[t[1]]).cwiseMin(P[t[2]]);
+    Hi[f] = P[t[0]].cwiseMax(P[t[1]]).cwiseMax(P[t[2]]);
+  }
+
+private:
+  const TriangleMesh& Input;
+  const TriangleTree& Tree;
+  OptimizeOptions Opt;
+  double Delta;
+  double SelfDelta;
+  Progress* Prog;
+  std::vector<Vec3> P;
+  std::vector<Triangle> T;
+  std::vector<std::vector<int>> VT;
+  std::vector<Vec3> Lo, Hi;
+  std::vector<Vec3> Representatives; ///< one input point per input component
+  mutable tbb::enumerable_thread_specific<Work> Works;
+};
+
+} // namespace
+
+double cageEnergy(const TriangleMesh& cage, const TriangleTree& inputTree, const OptimizeOptions& options)
+{
+  double e = 0.0;
+  for (const Triangle& t : cage.Triangles)
+    e += triangleEnergy(cage.Points[t[0]], cage.Points[t[1]], cage.Points[t[2]], inputTree, options);
+  return e;
+}
+
+double minimumAngle(const TriangleMesh& cage)
+{
+  double best = 180.0;
+  for (const Triangle& t : cage.Triangles)
+    for (int k = 0; k < 3; ++k)
+    {
+      const Vec3 u = cage.Points[t[(k + 1) % 3]] - cage.Points[t[k]];
+      const Vec3 w = cage.Points[t[(k + 2) % 3]] - cage.Points[t[k]];
+      best = std::min(best, std::atan2(u.cross(w).norm(), u.dot(w)) * 180.0 / M_PI);
+    }
+  return cage.Triangles.empty() ? 0.0 : best;
+}
+
+double collisionFreeFraction(const TriangleMesh& cage, int v, const Vec3& move, const TriangleMesh& input,
+  const TriangleTree& inputTree, double clearance, double selfClearance)
+{
+  if (v < 0 || v >= static_cast<int>(cage.Points.size()))
+    return 0.0;
+  OptimizeOptions o;
+  o.BarrierDistance = 0.0; // no barrier primitives needed
+  Optimizer opt(cage, input, inputTree, o, clearance, selfClearance, nullptr);
+  Optimizer::Local L;
+  opt.gather(v, move.norm(), L);
+  return opt.advance(L, move);
+}
+
+OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input, const TriangleTree& inputTree,
+  const OptimizeOptions& options, Progress* progress, double progressBegin, double progressEnd)
+{
+  // stages over [progressBegin, progressEnd] of the whole run
+  const auto stage = [&](const char* name, double b, double e) {
+    progressStage(progress, name, progressBegin + (progressEnd - progressBegin) * b,
+      progressBegin + (progressEnd - progressBegin) * e);
+  };
+  OptimizeResult r;
+  const auto start = std::chrono::steady_clock::now();
+  r.Cage = cage;
+  if (cage.Triangles.empty() || input.Triangles.empty())
+  {
+    r.State = Status::EmptyInput;
+    r.Message = cage.Triangles.empty() ? "the cage has no triangles" : "the input mesh has no triangles";
+    return r;
+  }
+  if (!(options.TargetSpacing >= 0) || !(options.BarrierWeight >= 0) || !(options.BarrierDistance >= 0) ||
+    !std::isfinite(options.TargetSpacing + options.BarrierWeight + options.BarrierDistance))
+  {
+    r.State = Status::InvalidInput;
+    r.Message = "TargetSpacing, BarrierWeight and BarrierDistance must be finite and >= 0";
+    return r;
+  }
+  // the given cage must already satisfy the guarantees; measure its clearance
+  stage("verifying the given cage", 0.0, 0.05);
+  std::string why;
+  double measured = 0.0;
+  const auto tv = std::chrono::steady_clock::now();
+  if (!verifyEnclosure(input, cage, std::numeric_limits<double>::min(), measured, why, nullptr, nullptr, true, &inputTree))
+  {
+    r.State = Status::InvalidInput;
+    r.Message = "the given cage does not enclose the input without self-intersection: " + why;
+    return r;
+  }
+  double delta = options.Clearance;
+  if (!(delta > 0))
+    delta = std::min(DefaultClearance, measured);
+  else if (measured < delta)
+  {
+    r.State = Status::InvalidInput;
+    r.Message = "the given cage is " + std::to_string(measured) + " from the input, closer than the clearance " +
+      std::to_string(delta) + " to keep (unit-sphere units): lower MinimumClearance or use 0 (automatic)";
+    return r;
+  }
+  const double selfDelta = options.SelfClearance > 0 ? options.SelfClearance : delta / 4;
+  r.ClearanceUsed = delta;
+  r.EnergyBefore = cageEnergy(cage, inputTree, options);
+  r.MinimumAngleBefore = minimumAngle(cage);
+  r.VerificationSeconds = seconds(tv);
+
+  Optimizer opt(cage, input, inputTree, options, delta, selfDelta, progress);
+  bool cancelled = false;
+  const auto copyCounts = [&]() {
+    long long c[4];
+    opt.counts(c);
+    r.MovesWithoutDescent = c[0];
+    r.MovesCutByCollision = c[1];
+    r.MovesVetoedByShape = c[2];
+    r.MovesVetoedBySelfIntersection = c[3];
+  };
+  const int rounds = std::max(0, options.NumberOfIterations);
+  const std::clock_t cpu0 = std::clock();
+  for (int it = 0; it < rounds && !cancelled; ++it)
+  {
+    stage("relocating cage vertices", 0.05 + 0.85 * it / rounds, 0.05 + 0.85 * (it + 0.8) / rounds);
+    const auto t0 = std::chrono::steady_clock::now();
+    cancelled = !opt.relocationPass(r, 0.0, 1.0);
+    r.RelocationSeconds += seconds(t0);
+    if (!cancelled && options.EdgeFlips)
+    {
+      stage("flipping cage edges", 0.05 + 0.85 * (it + 0.8) / rounds, 0.05 + 0.85 * (it + 1.0) / rounds);
+      const auto t1 = std::chrono::steady_clock::now();
+      cancelled = !opt.flipPass(r);
+      r.FlipSeconds += seconds(t1);
+    }
+  }
+
+  r.RelocationAndFlipCpuSeconds = double(std::clock() - cpu0) / CLOCKS_PER_SEC;
+  copyCounts();
+  // independent verification of the result (also after a cancel: the partial result is valid)
+  stage("verifying the optimized cage", 0.9, 1.0);
+  const auto t2 = std::chrono::steady_clock::now();
+  TriangleMesh result = opt.mesh();
+  double clearance = 0.0;
+  std::vector<double> dist;
+  if (verifyEnclosure(input, result, delta, clearance, why, &dist, nullptr, true, &inputTree))
+  {
+    r.Cage = std::move(result);
+    r.MinimumClearance = clearance;
+    r.DistanceToInput = std::move(dist);
+  }
+  else
+  {
+    // should not happen: every change was checked. Keep the given (verified) cage.
+    r.Reverted = true;
+    r.Message = "the optimized cage failed verification (" + why + "); the given cage is returned unchanged";
+    r.Cage = cage;
+    verifyEnclosure(input, cage, std::numeric_limits<double>::min(), clearance, why, &dist, nullptr, true, &inputTree);
+    r.MinimumClearance = clearance;
+    r.DistanceToInput = std::move(dist);
+  }
+  r.VerificationSeconds += seconds(t2);
+  r.EnergyAfter = cageEnergy(r.Cage, inputTree, options);
+  r.MinimumAngleAfter = minimumAngle(r.Cage);
+  r.State = cancelled ? Status::Cancelled : Status::Ok;
+  if (cancelled && r.Message.empty())
+    r.Message = "cancelled during optimization; the cage so far is valid";
+  r.Seconds = seconds(start);
+  progressUpdate(progress, 1.0);
+  return r;
+}
+
+OptimizeResult optimizeCageInInputUnits(const TriangleMesh& cage, const TriangleMesh& input,
+  const OptimizeOptions& options, Progress* progress)
+{
+  OptimizeResult r;
+  r.Cage = cage;
+  TriangleMesh in, cg;
+  const MeshDefects di = prepareMesh(PolygonMesh::fromTriangles(input), in);
+  if (!di.usable())
+  {
+    r.State = di.Empty ? Status::EmptyInput : Status::InvalidInput;
+    r.Message = "input mesh: " + (di.Empty ? std::string("it has no triangles") : di.errorMessage());
+    return r;
+  }
+  const MeshDefects dc = prepareMesh(PolygonMesh::fromTriangles(cage), cg);
+  if (!dc.usable())
+  {
+    r.State = dc.Empty ? Status::EmptyInput : Status::InvalidInput;
+    r.Message = "cage: " + (dc.Empty ? std::string("it has no triangles") : dc.errorMessage());
+    return r;
+  }
+  const Normalization n = Normalization::fit(in);
+  const TriangleMesh unitInput = n.toUnit(in);
+  const TriangleTree tree(unitInput);
+  OptimizeResult u = optimizeCage(n.toUnit(cg), unitInput, tree, options, progress);
+  u.Cage = n.toInput(u.Cage);
+  for (double& d : u.DistanceToInput)
+    d = n.lengthToInput(d);
+  u.MinimumClearance = n.lengthToInput(u.MinimumClearance);
+  return u;
+}
+
+} // namespace sdfcage

@@ -1,0 +1,199 @@
+#include "Pipeline/CageGenerator.h"
+
+#include "Common/Progress.h"
+#include "Quality/Verification.h"
+#include "Spatial/TriangleTree.h"
+
+#include <tbb/global_control.h>
+
+#include <chrono>
+#include <memory>
+
+namespace sdfcage
+{
+
+namespace
+{
+double seconds(std::chrono::steady_clock::time_point t0)
+{
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+} // namespace
+
+ScalarImage imageToInput(ScalarImage image, const Normalization& n)
+{
+  image.Origin = n.toInput(image.Origin);
+  image.Spacing = n.lengthToInput(image.Spacing);
+  for (float& v : image.Values)
+  {
+    v = static_cast<float>(n.lengthToInput(v));
+  }
+  return image;
+}
+
+CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Progress* progress)
+{
+  CageResult result;
+  const auto start = std::chrono::steady_clock::now();
+  std::unique_ptr<tbb::global_control> threads;
+  if (options.Envelope.NumberOfThreads > 0)
+  {
+    threads = std::make_unique<tbb::global_control>(
+      tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(options.Envelope.NumberOfThreads));
+  }
+
+  // 1. validation
+  progressStage(progress, "validating input", 0.0, 0.02);
+  TriangleMesh mesh;
+  result.Defects = prepareMesh(input, mesh, options.Validation);
+  result.ValidationSeconds = seconds(start);
+  if (result.Defects.Empty && result.Defects.usable() == false &&
+    result.Defects.NonFinitePoints == 0 && result.Defects.InvalidPointIds == 0 &&
+    result.Defects.UntriangulatedPolygons == 0)
+  {
+    result.State = Status::EmptyInput;
+    result.Message = "the input has no triangles";
+    return result;
+  }
+  if (!result.Defects.usable())
+  {
+    result.State = Status::InvalidInput;
+    result.Message = result.Defects.errorMessage();
+    return result;
+  }
+  if (progressCancelled(progress))
+  {
+    result.State = Status::Cancelled;
+    result.Message = "cancelled";
+    return result;
+  }
+
+  // 2. normalization into the unit sphere: every length parameter is relative to it
+  result.Normalize = Normalization::fit(mesh);
+  const Normalization& n = result.Normalize;
+  const TriangleMesh unit = n.toUnit(mesh);
+
+  // 3. the verified envelope
+  // when the dense envelope is itself the cage, its exact clearance is the one to report
+  EnvelopeOptions envelopeOptions = options.Envelope;
+  envelopeOptions.ExactEnvelopeClearance = envelopeOptions.ExactEnvelopeClearance || options.TargetNumberOfVertices <= 0;
+  EnvelopeResult env =
+    buildEnvelope(unit, envelopeOptions, progress, options.TargetNumberOfVertices > 0 ? 0.45 : 1.0);
+  result.DistanceFieldSeconds = env.DistanceFieldSeconds;
+  result.IsosurfaceSeconds = env.IsosurfaceSeconds;
+  result.VerificationSeconds = env.VerificationSeconds;
+  result.VoxelSizeUsed = env.VoxelSizeUsed;
+  result.RemovedPockets = env.RemovedPockets;
+  result.InputGenus = env.InputGenus;
+  result.InputComponents = env.InputComponents;
+  result.NumberOfActivePoints = env.NumberOfActivePoints;
+  result.NumberOfActiveSamples = env.NumberOfActiveSamples;
+  result.ActivePointSeconds = env.ActivePointSeconds;
+  result.AmplificationSeconds = env.AmplificationSeconds;
+  result.TopologyWarning = env.TopologyWarning;
+  result.TotalSeconds = seconds(start);
+  if (env.State != Status::Ok)
+  {
+    result.State = env.State;
+    result.Message = env.Message;
+    return result;
+  }
+  result.EnclosureVerified = env.EnclosureVerified;
+  result.MinimumClearanceRelative = env.MinimumClearance;
+  result.MinimumClearance = n.lengthToInput(env.MinimumClearance);
+  result.EnvelopeGenus = env.Genus;
+  result.EnvelopeComponents = env.Components;
+  result.Envelope = n.toInput(env.Envelope);
+  result.EnvelopeDistanceToInput.resize(env.DistanceToInput.size());
+  for (std::size_t i = 0; i < env.DistanceToInput.size(); ++i)
+  {
+    result.EnvelopeDistanceToInput[i] = n.lengthToInput(env.DistanceToInput[i]);
+  }
+  if (options.Envelope.KeepDistanceField)
+  {
+    result.DistanceField = imageToInput(env.DistanceField, n);
+    result.ModifiedDistanceField = imageToInput(env.ModifiedDistanceField, n);
+  }
+
+  // 4. the cage: constrained simplification of the verified envelope, verified again
+  if (options.TargetNumberOfVertices <= 0)
+  {
+    result.Cage = result.Envelope;
+    result.CageDistanceToInput = result.EnvelopeDistanceToInput;
+    result.VerticesReached = static_cast<int>(result.Cage.Points.size());
+    result.TargetReached = true;
+    if (options.Optimize)
+      result.Optimization.Message = "the optimization needs a simplified cage (a target number of vertices > 0)";
+  }
+  else
+  {
+    const std::shared_ptr<const TriangleTree> ownTree = env.InputTree ? nullptr : std::make_shared<TriangleTree>(unit);
+    const TriangleTree& tree = env.InputTree ? *env.InputTree : *ownTree;
+    SimplifyOptions so = options.Simplify;
+    so.TargetVertices = options.TargetNumberOfVertices;
+    so.Clearance = options.Envelope.clearance();
+    progressStage(progress, "simplifying", 0.45, 0.95);
+    result.Simplification = simplifyEnvelope(env.Envelope, tree, so, progress);
+    result.SimplificationSeconds = result.Simplification.Seconds;
+    result.VerticesReached = result.Simplification.VerticesReached;
+    result.TargetReached = result.Simplification.ReachedTarget;
+    result.StopReason = result.Simplification.StopReason;
+    // independent re-verification of the final cage (exact distances, winding numbers). It runs
+    // even after a cancel: the partial cage is valid and usable.
+    progressStage(progress, "verifying cage", 0.95, options.Optimize ? 0.96 : 1.0);
+    const auto t1 = std::chrono::steady_clock::now();
+    std::vector<double> dist;
+    std::string why;
+    double clearance = 0.0;
+    const bool ok = verifyEnclosure(unit, result.Simplification.Cage, so.Clearance, clearance, why, &dist, nullptr, true, &tree);
+    result.CageVerificationSeconds = seconds(t1);
+    if (!ok)
+    {
+      result.State = Status::VerificationFailed;
+      result.Message = "the simplified cage failed verification: " + why;
+      result.EnclosureVerified = false;
+      result.TotalSeconds = seconds(start);
+      return result;
+    }
+    // 5. optional optimization (§3.3): it verifies its own result, and keeps the simplified cage
+    // if that ever fails
+    if (options.Optimize && !result.Simplification.Cancelled && !progressCancelled(progress))
+    {
+      OptimizeOptions oo = options.Optimization;
+      oo.Clearance = so.Clearance;
+      result.Optimization = optimizeCage(result.Simplification.Cage, unit, tree, oo, progress, 0.96, 1.0);
+      result.OptimizationSeconds = result.Optimization.Seconds;
+      const Status os = result.Optimization.State;
+      if ((os == Status::Ok || os == Status::Cancelled) && !result.Optimization.Reverted)
+      {
+        result.Optimized = true;
+        result.Simplification.Cage = std::move(result.Optimization.Cage);
+        dist = std::move(result.Optimization.DistanceToInput);
+        clearance = result.Optimization.MinimumClearance;
+      }
+      result.Optimization.Cage = TriangleMesh();
+      result.Optimization.DistanceToInput.clear();
+    }
+    result.Cage = n.toInput(result.Simplification.Cage);
+    result.CageDistanceToInput.resize(dist.size());
+    for (std::size_t i = 0; i < dist.size(); ++i)
+      result.CageDistanceToInput[i] = n.lengthToInput(dist[i]);
+    result.MinimumClearanceRelative = clearance;
+    result.MinimumClearance = n.lengthToInput(clearance);
+    result.Simplification.Cage = TriangleMesh(); // the result keeps the input-unit copy only
+    if (result.Simplification.Cancelled || result.Optimization.State == Status::Cancelled)
+    {
+      result.State = Status::Cancelled;
+      result.Message = result.Simplification.Cancelled ? "cancelled during simplification; the cage so far is valid"
+                                                        : "cancelled during optimization; the cage so far is valid";
+      result.TotalSeconds = seconds(start);
+      return result;
+    }
+  }
+  result.State = Status::Ok;
+  result.TotalSeconds = seconds(start);
+  progressUpdate(progress, 1.0);
+  return result;
+}
+
+} // namespace sdfcage

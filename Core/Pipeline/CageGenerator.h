@@ -1,0 +1,77 @@
+// SDFCage — Core: the whole pipeline, mesh in input coordinates -> cage in input coordinates.
+#pragma once
+
+#include "Envelope/Envelope.h"
+#include "Mesh/Normalization.h"
+#include "Optimization/Optimization.h"
+#include "Simplification/Simplification.h"
+#include "Mesh/Validation.h"
+
+namespace sdfcage
+{
+
+struct CageOptions
+{
+  EnvelopeOptions Envelope;
+  ValidationOptions Validation;
+  /// Target vertex count of the cage; 0 keeps the dense verified envelope as the cage.
+  int TargetNumberOfVertices = 500;
+  /// Simplification knobs (Clearance is taken from Envelope.clearance()).
+  SimplifyOptions Simplify;
+  /// Optional optimization of the simplified cage (paper §3.3); off by default. Its Clearance is
+  /// taken from Envelope.clearance(). Not applied when TargetNumberOfVertices is 0.
+  bool Optimize = false;
+  OptimizeOptions Optimization;
+};
+
+struct CageResult
+{
+  Status State = Status::Failed;
+  std::string Message;              ///< error or cancellation reason (empty when Ok)
+  MeshDefects Defects;              ///< validation report of the input
+  TriangleMesh Cage;                ///< input coordinates
+  std::vector<double> CageDistanceToInput; ///< per cage point, input units
+  TriangleMesh Envelope;            ///< input coordinates
+  std::vector<double> EnvelopeDistanceToInput; ///< per envelope point, input units
+  double MinimumClearance = 0.0;    ///< measured, input units
+  double MinimumClearanceRelative = 0.0; ///< measured, unit-sphere units
+  bool EnclosureVerified = false;
+  int RemovedPockets = 0;
+  int EnvelopeGenus = 0;
+  int EnvelopeComponents = 0;
+  double VoxelSizeUsed = 0.0;       ///< unit-sphere units
+  int InputGenus = 0;
+  int InputComponents = 0;
+  std::size_t NumberOfActivePoints = 0;  ///< input points flagged active (0 when off)
+  std::size_t NumberOfActiveSamples = 0; ///< the active set A on the surface sampling
+  double ActivePointSeconds = 0.0;
+  double AmplificationSeconds = 0.0; ///< phi xi on the grid, part of DistanceFieldSeconds
+  /// Non-empty when the envelope (and so the cage) does not have the input's genus and
+  /// component count: parts closer than the parameters can separate were fused.
+  std::string TopologyWarning;
+  double ValidationSeconds = 0.0;
+  double DistanceFieldSeconds = 0.0;
+  double IsosurfaceSeconds = 0.0;
+  double VerificationSeconds = 0.0;
+  int VerticesReached = 0;          ///< cage vertex count
+  bool TargetReached = false;       ///< VerticesReached == TargetNumberOfVertices (or target 0)
+  std::string StopReason;           ///< why simplification stopped early (empty otherwise)
+  SimplifyResult Simplification;    ///< statistics of the simplification
+  double SimplificationSeconds = 0.0;
+  double CageVerificationSeconds = 0.0;
+  OptimizeResult Optimization;      ///< statistics of the optional optimization (its Cage is cleared)
+  bool Optimized = false;           ///< the optimization ran and its result is the cage
+  double OptimizationSeconds = 0.0;
+  double TotalSeconds = 0.0;
+  ScalarImage DistanceField;        ///< input coordinates and units, when requested
+  ScalarImage ModifiedDistanceField; ///< phi * xi, input units, when requested and active points exist
+  Normalization Normalize;
+};
+
+/// A field sampled in unit-sphere units, mapped back to input coordinates and lengths.
+ScalarImage imageToInput(ScalarImage image, const Normalization& n);
+
+CageResult generateCage(const PolygonMesh& input, const CageOptions& options,
+  Progress* progress = nullptr);
+
+} // namespace sdfcage

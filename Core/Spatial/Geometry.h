@@ -1,0 +1,34 @@
+// SDFCage — Core: exact-in-effect distance primitives (double precision, robust formulas).
+#pragma once
+
+#include "Mesh/Mesh.h"
+
+namespace sdfcage
+{
+
+/// Closest point on triangle (a, b, c) to p (Ericson, Real-Time Collision Detection §5.1.5).
+Vec3 closestPointOnTriangle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c);
+
+/// Squared distance between segments [p0, p1] and [q0, q1].
+double segmentSegmentDistance2(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1);
+/// The same, also giving the closest points p0 + s (p1 - p0) and q0 + t (q1 - q0), s, t in [0, 1].
+double segmentSegmentClosest(const Vec3& p0, const Vec3& p1, const Vec3& q0, const Vec3& q1, double& s, double& t);
+
+/// Squared distance between two triangles (0 when they intersect).
+double triangleTriangleDistance2(const Vec3 a[3], const Vec3 b[3]);
+
+/// Two triangles sharing exactly vertex a, (a, b, c) and (a, d, e): do they meet anywhere
+/// else? Nearly coplanar pairs whose corners overlap count as meeting (conservative).
+bool meetBeyondSharedVertex(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, const Vec3& e);
+
+/// Do two triangles of one mesh (vertex ids ia/ib, points pa/pb) conflict? Triangles sharing no
+/// vertex conflict when they intersect or come closer than `separation`; sharing one vertex, when
+/// they meet anywhere else; sharing an edge, when their normals' cosine is below `foldCosine`
+/// (folded onto each other; -1 + tiny for exact intersection only).
+bool trianglesConflict(const int ia[3], const Vec3 pa[3], const int ib[3], const Vec3 pb[3],
+  double separation, double foldCosine);
+
+/// Generalized winding number of a closed triangle mesh at p (about 1 inside, 0 outside).
+double windingNumber(const TriangleMesh& mesh, const Vec3& p);
+
+} // namespace sdfcage

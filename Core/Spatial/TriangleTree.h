@@ -1,0 +1,67 @@
+// SDFCage — Core: a static bounding-volume hierarchy over a triangle mesh for exact distance
+// queries between points or triangles and the mesh (used for the input during simplification
+// and verification, where query triangles can be far larger than the mesh's triangles).
+#pragma once
+
+#include "Mesh/Mesh.h"
+
+#include <vector>
+
+namespace sdfcage
+{
+
+class TriangleTree
+{
+public:
+  TriangleTree() = default;
+  explicit TriangleTree(const TriangleMesh& mesh) { this->build(mesh); }
+  void build(const TriangleMesh& mesh);
+
+  /// Closest point on the mesh to p within maxDistance (<0: unlimited). False when none.
+  bool closestPoint(const Vec3& p, double maxDistance, Vec3& closest, int& triangle, double& distance) const;
+  double distance(const Vec3& p) const;
+
+  /// Exact distance between the triangle t and the mesh, or `limit` when it is not below limit.
+  double triangleDistance(const Vec3 t[3], double limit) const;
+  /// True when some mesh triangle comes closer than `delta` to triangle t (stops at the first).
+  bool anyCloserThan(const Vec3 t[3], double delta) const;
+  /// Number of mesh triangles at distance <= delta from triangle t (0 counts: intersecting or
+  /// touching). Used to count intersecting pairs.
+  long long countWithin(const Vec3 t[3], double delta) const;
+  /// Appends to `ids` the mesh triangles closer than `radius` to triangle t (exact distances).
+  void trianglesWithin(const Vec3 t[3], double radius, std::vector<int>& ids) const;
+
+  /// Unit normal of mesh triangle `id` (zero for degenerate triangles).
+  const Vec3& normal(int id) const { return Normals[id]; }
+
+  bool empty() const { return Nodes.empty(); }
+  std::size_t size() const { return Tri.size(); }
+
+private:
+  struct Node
+  {
+    Vec3 Lo, Hi;
+    int Left = -1;  // child index, or -1 for a leaf
+    int Right = -1;
+    int Start = 0;  // leaf: range into Tri
+    int Count = 0;
+  };
+  struct Tri3
+  {
+    Vec3 P[3];
+    int Id;
+  };
+  struct BuildItem
+  {
+    Vec3 C; // centroid
+    int Id;
+  };
+  void buildNode(int index, int start, int count, std::vector<BuildItem>& items, const std::vector<Tri3>& tri,
+    int depth);
+  double triangleQuery(const Vec3 t[3], double limit, bool stopAtFirst, std::vector<int>* within = nullptr) const;
+  std::vector<Node> Nodes;
+  std::vector<Tri3> Tri;
+  std::vector<Vec3> Normals;
+};
+
+} // namespace sdfcage
