@@ -26,6 +26,7 @@
 #include "vtkStringArray.h"
 
 #include "Pipeline/CageGenerator.h"
+#include "Pipeline/Results.h"
 #include "SDFCageVTKConversion.h"
 #include "Common/Progress.h"
 
@@ -103,6 +104,8 @@ void vtkSDFCageFilter::ResetResults()
   this->NumberOfActivePoints = 0;
   this->ActivePointTime = 0.0;
   this->TopologyWarning.clear();
+  this->ResultNumbers.clear();
+  this->ResultTexts.clear();
   this->StatusString = "NotExecuted";
   this->LastErrorMessage.clear();
 }
@@ -169,6 +172,14 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
     AddFieldValue<vtkIdTypeArray>(fd, "NumberOfActivePoints", this->NumberOfActivePoints);
     AddFieldValue<vtkDoubleArray>(fd, "ActivePointTime", this->ActivePointTime);
     AddFieldValue<vtkStringArray>(fd, "TopologyWarning", this->TopologyWarning);
+    for (const auto& kv : this->ResultNumbers)
+    {
+      AddFieldValue<vtkDoubleArray>(fd, kv.first.c_str(), kv.second);
+    }
+    for (const auto& kv : this->ResultTexts)
+    {
+      AddFieldValue<vtkStringArray>(fd, kv.first.c_str(), kv.second);
+    }
     AddFieldValue<vtkStringArray>(fd, "Status", this->StatusString);
     AddFieldValue<vtkStringArray>(fd, "LastErrorMessage", this->LastErrorMessage);
   };
@@ -192,8 +203,9 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
     std::ostringstream msg;
     msg << "The input has " << input->GetNumberOfVerts() << " vertex and "
         << input->GetNumberOfLines()
-        << " line cells but no polygons: a closed surface mesh is required (for a point cloud, "
-           "reconstruct a surface first, e.g. with vtkSurfaceReconstructionFilter).";
+        << " line cells but no polygons: a surface mesh is required (for a point cloud, "
+           "reconstruct a surface first, e.g. with vtkSurfaceReconstructionFilter or ParaView's "
+           "Delaunay 3D + Extract Surface).";
     return fail(StatusIdentifier(sdfcage::Status::InvalidInput), msg.str());
   }
 
@@ -216,6 +228,7 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
     options.Envelope.ActivePoints.Alpha = this->AmplificationAlpha;
     options.Envelope.ActivePoints.Beta = this->AmplificationBeta;
     options.Envelope.NumberOfThreads = this->NumberOfThreads;
+    options.Envelope.Sign = static_cast<sdfcage::SignMode>(this->SignMode);
     options.Optimize = this->Optimize != 0;
     options.Optimization.Energy = this->Energy == 1 ? sdfcage::CageEnergy::Spacing : sdfcage::CageEnergy::MIPS;
     options.Optimization.TargetSpacing = this->TargetSpacing;
@@ -252,6 +265,13 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
     this->NumberOfActivePoints = static_cast<vtkIdType>(result.NumberOfActivePoints);
     this->ActivePointTime = result.ActivePointSeconds;
     this->TopologyWarning = result.TopologyWarning;
+    for (const sdfcage::ResultField& f : sdfcage::inputResults(result))
+    {
+      if (f.Type == sdfcage::ResultField::Kind::Text)
+        this->ResultTexts[f.Name] = f.Text;
+      else
+        this->ResultNumbers[f.Name] = f.number();
+    }
     this->StatusString = StatusIdentifier(result.State);
     this->LastErrorMessage = result.Message;
 
@@ -375,6 +395,7 @@ void vtkSDFCageFilter::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "AmplificationBeta: " << this->AmplificationBeta << "\n";
   os << indent << "NumberOfActivePoints: " << this->NumberOfActivePoints << "\n";
   os << indent << "TopologyWarning: " << this->TopologyWarning << "\n";
+  os << indent << "SignMode: " << this->SignMode << "\n";
   os << indent << "GenerateDistanceField: " << (this->GenerateDistanceField ? "On" : "Off")
      << "\n";
   os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";
@@ -405,4 +426,18 @@ void vtkSDFCageFilter::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "EnvelopeComponents: " << this->EnvelopeComponents << "\n";
   os << indent << "VoxelSizeUsed: " << this->VoxelSizeUsed << "\n";
   os << indent << "InputWasFlipped: " << this->InputWasFlipped << "\n";
+}
+
+//------------------------------------------------------------------------------
+double vtkSDFCageFilter::GetResultNumber(const char* name) const
+{
+  const auto it = name ? this->ResultNumbers.find(name) : this->ResultNumbers.end();
+  return it == this->ResultNumbers.end() ? 0.0 : it->second;
+}
+
+//------------------------------------------------------------------------------
+const char* vtkSDFCageFilter::GetResultText(const char* name) const
+{
+  const auto it = name ? this->ResultTexts.find(name) : this->ResultTexts.end();
+  return it == this->ResultTexts.end() ? "" : it->second.c_str();
 }

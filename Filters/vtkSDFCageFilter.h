@@ -70,6 +70,7 @@
 #include "SDFCageFiltersModule.h" // For export macro
 #include "vtkPolyDataAlgorithm.h"
 
+#include <map>    // For the results by name
 #include <string> // For the status strings
 
 class SDFCAGEFILTERS_EXPORT vtkSDFCageFilter : public vtkPolyDataAlgorithm
@@ -125,6 +126,37 @@ public:
    */
   vtkSetClampMacro(Adaptivity, double, 0.0, 1.0);
   vtkGetMacro(Adaptivity, double);
+  ///@}
+
+  ///@{
+  /**
+   * How the inside of the input is decided. Auto (0, default): a closed, consistently oriented
+   * 2-manifold input keeps the flood-fill path (FloodFill, 1); any other input (open scans,
+   * soups of overlapping parts, non-manifold or inconsistently oriented meshes) is signed by its
+   * generalized winding number (WindingNumber, 2): holes and cracks are bridged and the solid is
+   * caged, an open sheet is wrapped on both sides. Unsigned (3) has no inside at all: the cage
+   * wraps every sheet on both sides. Active points are used with FloodFill only. The rule used
+   * and why: GetResultText("SignMode"), GetResultText("SignReason").
+   */
+  vtkSetClampMacro(SignMode, int, 0, 3);
+  vtkGetMacro(SignMode, int);
+  void SetSignModeToAuto() { this->SetSignMode(0); }
+  void SetSignModeToFloodFill() { this->SetSignMode(1); }
+  void SetSignModeToWindingNumber() { this->SetSignMode(2); }
+  void SetSignModeToUnsigned() { this->SetSignMode(3); }
+  ///@}
+
+  ///@{
+  /**
+   * Results of the last execution by name, as in the field data of the cage: what was done to
+   * the input (MergedPoints, MergeTolerance, TriangulatedPolygons, DroppedDegenerateTriangles,
+   * DroppedDuplicateTriangles, IgnoredCells), what it is (InputBoundaryEdges,
+   * InputNonManifoldEdges, InputNonManifoldVertices, InputInconsistentEdges, InputComponents,
+   * InputClosed, InputGenus: -1 when undefined) and how its inside was decided (SignMode,
+   * SignReason, WindingTime). GetResultNumber gives 0 and GetResultText "" for unknown names.
+   */
+  double GetResultNumber(const char* name) const;
+  const char* GetResultText(const char* name) const;
   ///@}
 
   ///@{
@@ -319,6 +351,7 @@ protected:
   double BarrierDistance;
   int NumberOfIterations;
   vtkTypeBool EdgeFlips;
+  int SignMode = 0;
 
   // results of the last execution
   double ValidationTime = 0.0;
@@ -343,6 +376,8 @@ protected:
   double VoxelSizeUsed = 0.0;
   bool InputWasFlipped = false;
   vtkIdType NumberOfActivePoints = 0;
+  std::map<std::string, double> ResultNumbers; // the table results (Core's inputResults)
+  std::map<std::string, std::string> ResultTexts;
   double ActivePointTime = 0.0;
   std::string TopologyWarning;
   std::string StatusString;

@@ -33,19 +33,21 @@ ActivePointAnalysis analyzeActivePoints(
   }
   progressStage(progress, "validating input", 0.0, 0.02);
   result.Defects = prepareMesh(input, result.Mesh, options.Validation);
-  // as generateCage: nothing usable at all is "empty", a defect is an error naming it
-  if (result.Defects.Empty && !result.Defects.usable() && result.Defects.NonFinitePoints == 0 &&
-    result.Defects.InvalidPointIds == 0 && result.Defects.UntriangulatedPolygons == 0)
+  if (!result.Defects.usableAsInput())
   {
-    result.State = Status::EmptyInput;
-    result.Message = "the input has no triangles";
+    const bool nothing = result.Defects.Empty && result.Defects.NonFinitePoints == 0 && result.Defects.InvalidPointIds == 0;
+    result.State = nothing ? Status::EmptyInput : Status::InvalidInput;
+    result.Message = result.Defects.inputErrorMessage();
     result.Mesh = TriangleMesh();
     return result;
   }
-  if (!result.Defects.usable() || result.Mesh.empty())
+  if (!result.Defects.usable())
   {
+    // the geodesic rule of §3.1 measures along a closed surface
     result.State = Status::InvalidInput;
-    result.Message = result.Defects.errorMessage();
+    result.Message = "active points need a closed, consistently oriented 2-manifold input (the cage filter "
+                     "cages any other input by its winding number, without active points): " +
+      result.Defects.errorMessage();
     result.Mesh = TriangleMesh();
     return result;
   }

@@ -363,8 +363,24 @@ std::size_t projectOntoAmplifiedOffset(
 
 } // namespace
 
+const char* signModeName(SignMode m)
+{
+  switch (m)
+  {
+    case SignMode::Auto:
+      return "auto";
+    case SignMode::FloodFill:
+      return "flood";
+    case SignMode::WindingNumber:
+      return "winding";
+    case SignMode::Unsigned:
+      return "unsigned";
+  }
+  return "unknown";
+}
+
 EnvelopeResult buildEnvelope(
-  const TriangleMesh& unitInput, const EnvelopeOptions& options, Progress* progress, double progressEnd)
+  const TriangleMesh& unitInput, const EnvelopeOptions& options, Progress* progress, double progressEnd, int inputClosed)
 {
   EnvelopeResult result;
   if (unitInput.empty())
@@ -382,11 +398,41 @@ EnvelopeResult buildEnvelope(
     result.Message = "invalid parameters: need IsoValue > 0, VoxelSize > 0 and 0 < MinimumClearance < IsoValue";
     return result;
   }
+  // The inside rule: flood fill for a closed, consistently oriented 2-manifold, the winding
+  // number for anything else, unless the caller forces one.
+  result.InputClosed = inputClosed >= 0 ? inputClosed == 1 : checkTriangleMesh(unitInput).usable();
+  if (options.Sign == SignMode::Auto)
+  {
+    result.SignUsed = result.InputClosed ? SignMode::FloodFill : SignMode::WindingNumber;
+    result.SignReason = result.InputClosed
+      ? "auto: the input is a closed, consistently oriented 2-manifold"
+      : "auto: the input is not a closed, consistently oriented 2-manifold (open, non-manifold, or "
+        "inconsistently oriented)";
+  }
+  else
+  {
+    result.SignUsed = options.Sign;
+    result.SignReason = "requested";
+  }
+  const bool flood = result.SignUsed == SignMode::FloodFill;
+  const bool useActivePoints = options.UseActivePoints && flood;
+  if (options.UseActivePoints && !flood)
+  {
+    result.SignReason += "; active points skipped (they need a closed input and the flood-fill rule)";
+  }
   // The input's tree for the verification is built meanwhile (on another thread when there is
-  // one): the active points and the distance field come first.
+  // one): the active points and the distance field come first. The winding-number rule needs
+  // its dipoles too.
   auto inputTree = std::make_shared<TriangleTree>();
   tbb::task_group treeTask;
-  treeTask.run([&unitInput, inputTree] { inputTree->build(unitInput); });
+  const bool winding = result.SignUsed == SignMode::WindingNumber;
+  treeTask.run([&unitInput, inputTree, winding] {
+    inputTree->build(unitInput);
+    if (winding)
+    {
+      inputTree->prepareWindingNumbers();
+    }
+  });
   struct WaitFor
   {
     tbb::task_group& Group;
@@ -413,12 +459,12 @@ EnvelopeResult buildEnvelope(
   {
     std::vector<int> comp;
     result.InputComponents = triangleComponents(unitInput, comp);
-    result.InputGenus = genus(unitInput);
+    result.InputGenus = result.InputClosed ? genus(unitInput) : -1;
   }
   ActivePoints active;
   const ActivePoints* amplification = nullptr;
   std::unique_ptr<TriangleTree> surfaceTree;
-  if (options.UseActivePoints)
+  if (useActivePoints)
   {
     const std::string bad = options.ActivePoints.validate();
     if (!bad.empty())
@@ -444,7 +490,7 @@ EnvelopeResult buildEnvelope(
       surfaceTree = std::make_unique<TriangleTree>(active.Surface);
     }
   }
-  const double fieldBegin = options.UseActivePoints ? 0.12 * progressEnd : 0.02;
+  const double fieldBegin = useActivePoints ? 0.12 * progressEnd : 0.02;
   // Attempts: the requested grid, first with the requested adaptivity and, if that envelope fails
   // verification (merged polygons can cut corners or cross), without it from the same field; then
   // finer grids without adaptivity.
@@ -506,8 +552,10 @@ EnvelopeResult buildEnvelope(
       result.VerificationSeconds += seconds(t1);
       return ok;
     };
-    IsosurfaceOutput iso = computeIsosurface(
-      unitInput, h, c, options.KeepDistanceField, progress, adaptivities, amplification, &judge, 4);
+    IsosurfaceOutput iso = computeIsosurface(unitInput, h, c, options.KeepDistanceField, progress, adaptivities,
+      amplification, &judge, 4, result.SignUsed, winding ? &tree() : nullptr);
+    result.WindingSeconds += iso.WindingSeconds;
+    result.WindingEvaluations += iso.WindingEvaluations;
     result.AmplifiedVoxels = iso.AmplifiedVoxels;
     result.AmplificationSeconds += iso.AmplificationSeconds;
     result.AdaptiveRepairs = iso.Repairs;
@@ -532,14 +580,15 @@ EnvelopeResult buildEnvelope(
       std::vector<int> comp;
       result.Components = triangleComponents(result.Envelope, comp);
       result.Genus = genus(result.Envelope);
-      if (result.Genus != result.InputGenus || result.Components != result.InputComponents)
+      // the input's genus is defined for a closed input only
+      if (result.InputClosed && (result.Genus != result.InputGenus || result.Components != result.InputComponents))
       {
         std::ostringstream w;
         w << "the envelope has genus " << result.Genus << " and " << result.Components
           << " component(s), the input genus " << result.InputGenus << " and "
           << result.InputComponents << ": parts of the input closer than the parameters can "
           << "separate were fused";
-        if (!options.UseActivePoints)
+        if (!useActivePoints)
         {
           w << " (active points are off: turn them on)";
         }

@@ -17,9 +17,30 @@ namespace sdfcage
 class Progress;
 class TriangleTree;
 
+/// How the inside of the input, and so the sign of the distance field, is decided.
+enum class SignMode
+{
+  /// FloodFill for a closed, consistently oriented 2-manifold input, WindingNumber otherwise.
+  Auto = 0,
+  /// OpenVDB's flood fill from outside (the first wave's path): needs a closed input.
+  FloodFill,
+  /// Inside where the generalized winding number of the input exceeds 1/2 in magnitude: holes,
+  /// cracks, overlaps and flipped parts are bridged and the solid is caged; where there is no
+  /// solid (an open sheet, |w| < 1/2 on both sides) this is the unsigned offset, wrapping the sheet
+  /// on both sides.
+  WindingNumber,
+  /// No inside at all: the outer boundary of the unsigned offset {d <= c}; every sheet is wrapped
+  /// on both sides, and holes wider than 2c let the envelope in.
+  Unsigned
+};
+
+const char* signModeName(SignMode m);
+
 /// All lengths in unit-sphere units (the input is normalized first).
 struct EnvelopeOptions
 {
+  /// The inside rule (see SignMode). Auto decides from the input's topology.
+  SignMode Sign = SignMode::Auto;
   /// Isovalue c of the envelope {xi = c} (paper default 0.01).
   double IsoValue = 0.01;
   /// Voxel size h of the SDF grid; 0 = automatic (IsoValue / 2, which keeps the genus of the
@@ -58,6 +79,9 @@ struct EnvelopeOptions
 struct EnvelopeResult
 {
   Status State = Status::Failed;
+  SignMode SignUsed = SignMode::FloodFill; ///< the inside rule actually used (never Auto)
+  std::string SignReason;           ///< why that rule (Auto's choice or the request)
+  bool InputClosed = false;         ///< the input is a closed, consistently oriented 2-manifold
   std::string Message;              ///< what went wrong (empty when Ok)
   TriangleMesh Envelope;            ///< outer envelope, outward oriented, unit-sphere units
   std::vector<double> DistanceToInput; ///< per envelope point, unsigned, unit-sphere units
@@ -81,7 +105,9 @@ struct EnvelopeResult
   std::size_t AmplifiedVoxels = 0;       ///< voxels where phi > 1.001
   double ActivePointSeconds = 0.0;   ///< active points + g_A
   double AmplificationSeconds = 0.0; ///< xi -> phi xi on the grid (included in DistanceFieldSeconds)
-  int InputGenus = 0;
+  double WindingSeconds = 0.0;       ///< winding-number sign (included in DistanceFieldSeconds)
+  std::size_t WindingEvaluations = 0; ///< voxels whose winding number was evaluated
+  int InputGenus = 0;               ///< -1 where undefined (the input is not closed)
   int InputComponents = 0;
   /// Non-empty when the envelope's genus or component count differs from the input's (parts
   /// closer than the parameters can separate were fused, or handles closed): the envelope is
@@ -92,9 +118,15 @@ struct EnvelopeResult
   std::shared_ptr<const TriangleTree> InputTree;
 };
 
-/// Builds and verifies the envelope of a validated, normalized mesh (unit-sphere units).
+/// Builds and verifies the envelope of a validated, normalized mesh (unit-sphere units). The
+/// input may be any triangle soup (open, non-manifold, self-intersecting, overlapping parts):
+/// options.Sign says how its inside is decided. Active points (paper §3.1) are used with the
+/// flood-fill rule only (their geodesic rule needs a closed surface); otherwise they are skipped
+/// and the result says so.
 /// Progress runs from 0.02 to `progressEnd` of the whole run.
+/// `inputClosed`: 1 the input is a closed, consistently oriented 2-manifold, 0 it is not, -1
+/// unknown (then it is checked here).
 EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOptions& options,
-  Progress* progress = nullptr, double progressEnd = 1.0);
+  Progress* progress = nullptr, double progressEnd = 1.0, int inputClosed = -1);
 
 } // namespace sdfcage

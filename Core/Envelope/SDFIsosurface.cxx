@@ -3,6 +3,7 @@
 #include "Envelope/ActivePoints.h"
 #include "Spatial/Geometry.h"
 #include "Common/Progress.h"
+#include "Spatial/TriangleTree.h"
 
 #include <openvdb/openvdb.h>
 #include <openvdb/tools/Interpolation.h>
@@ -15,6 +16,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cstdint>
 #include <cmath>
@@ -339,7 +341,8 @@ bool computeDisplayFields(const TriangleMesh& unitMesh, double iso, double minSp
 
 IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSize, double iso,
   bool keepField, Progress* progress, const std::vector<double>& adaptivities,
-  const ActivePoints* amplification, const SurfaceJudge* judge, int maxRepairs)
+  const ActivePoints* amplification, const SurfaceJudge* judge, int maxRepairs, SignMode sign,
+  const TriangleTree* windingTree)
 {
   std::call_once(vdbInit, []() { openvdb::initialize(); });
   if (amplification && amplification->empty())
@@ -376,7 +379,8 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
   // side), and the envelope is verified anyway. Inside, one voxel is enough: the flood fill gives
   // the interior its sign. Narrow bands are most of the speed of this stage.
   const float exteriorBand = static_cast<float>(std::ceil(iso / voxelSize) + 1.0);
-  const float interiorBand = 1.0f;
+  const bool unsignedField = sign != SignMode::FloodFill;
+  const float interiorBand = unsignedField ? exteriorBand : 1.0f;
   VdbInterrupter sdfInterrupter(progress, 0.0, 0.6);
   openvdb::FloatGrid::Ptr grid;
   openvdb::Int32Grid::Ptr closestTriangle;
@@ -387,19 +391,64 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
   try
   {
     grid = openvdb::tools::meshToVolume<openvdb::FloatGrid>(
-      sdfInterrupter, adapter, *transform, exteriorBand, interiorBand, 0, closestTriangle.get());
+      sdfInterrupter, adapter, *transform, exteriorBand, interiorBand,
+      unsignedField ? openvdb::tools::UNSIGNED_DISTANCE_FIELD : 0, closestTriangle.get());
   }
   catch (const std::exception& e)
   {
     out.Error = std::string("OpenVDB could not compute the distance field: ") + e.what();
     return out;
   }
-  out.DistanceFieldSeconds = seconds(t0);
   if (progressCancelled(progress) || !grid)
   {
     out.Cancelled = true;
     return out;
   }
+  if (sign == SignMode::WindingNumber && windingTree)
+  {
+    // Only voxels at or beyond the isovalue can change the isosurface by their sign (below it,
+    // both signs are inside {xi < iso}); those inside by winding number become negative.
+    const auto tw = std::chrono::steady_clock::now();
+    openvdb::tree::LeafManager<openvdb::FloatTree> leaves(grid->tree());
+    std::atomic<std::size_t> evaluated{ 0 }, inside{ 0 };
+    const float isoF = static_cast<float>(iso);
+    tbb::parallel_for(leaves.leafRange(), [&](const openvdb::tree::LeafManager<openvdb::FloatTree>::LeafRange& r) {
+      std::size_t e = 0, in = 0;
+      for (auto leaf = r.begin(); leaf; ++leaf)
+      {
+        if (progressCancelled(progress))
+        {
+          return;
+        }
+        for (auto v = leaf->beginValueOn(); v; ++v)
+        {
+          if (*v < isoF)
+          {
+            continue;
+          }
+          const openvdb::Coord ijk = v.getCoord();
+          const Vec3 x(ijk.x() * voxelSize, ijk.y() * voxelSize, ijk.z() * voxelSize);
+          ++e;
+          if (std::abs(windingTree->windingNumber(x)) > 0.5)
+          {
+            v.setValue(-*v);
+            ++in;
+          }
+        }
+      }
+      evaluated += e;
+      inside += in;
+    });
+    out.WindingEvaluations = evaluated.load();
+    out.InsideVoxels = inside.load();
+    out.WindingSeconds = seconds(tw);
+    if (progressCancelled(progress))
+    {
+      out.Cancelled = true;
+      return out;
+    }
+  }
+  out.DistanceFieldSeconds = seconds(t0);
   out.ActiveVoxels = grid->activeVoxelCount();
   // Voxels where adaptivity is switched off: near active points (the amplified envelope lies
   // close to the input there, merged polygons would cut into the clearance) and, after a failed

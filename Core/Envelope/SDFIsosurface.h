@@ -13,6 +13,7 @@ namespace sdfcage
 {
 
 class Progress;
+class TriangleTree;
 struct ActivePoints;
 
 struct IsosurfaceOutput
@@ -28,6 +29,9 @@ struct IsosurfaceOutput
   std::size_t ActiveVoxels = 0;
   std::size_t AmplifiedVoxels = 0; ///< voxels whose value phi changed by more than 1e-3
   double AmplificationSeconds = 0.0; ///< xi -> phi xi on the grid (part of DistanceFieldSeconds)
+  double WindingSeconds = 0.0;     ///< the winding-number sign (part of DistanceFieldSeconds)
+  std::size_t WindingEvaluations = 0; ///< voxels whose winding number was evaluated
+  std::size_t InsideVoxels = 0;    ///< of those, the ones found inside
   double AcceptedAdaptivity = 0.0; ///< with a judge: the adaptivity of the accepted surface
   int Repairs = 0;                 ///< with a judge: re-extractions with a larger no-adaptivity region
 };
@@ -48,9 +52,15 @@ using SurfaceJudge = std::function<bool(const TriangleMesh& surface, double adap
 /// Without `judge`, Surfaces holds one surface per adaptivity. With it, the adaptivities are tried
 /// in order (each up to 1 + maxRepairs times, see SurfaceJudge) and Surfaces holds the first
 /// accepted surface only (empty if none).
+/// `sign` other than FloodFill computes OpenVDB's unsigned distance; with WindingNumber, the
+/// voxels whose sign matters for the isosurface at `iso` (value >= iso) are made negative where
+/// `windingTree` (the input's tree, prepareWindingNumbers() done) gives |w| > 1/2. The deep inside
+/// beyond the band reads as outside then and yields inward-facing pockets, which the envelope
+/// removes with the others.
 IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSize, double iso,
   bool keepField, Progress* progress, const std::vector<double>& adaptivities = { 0.0 },
-  const ActivePoints* amplification = nullptr, const SurfaceJudge* judge = nullptr, int maxRepairs = 3);
+  const ActivePoints* amplification = nullptr, const SurfaceJudge* judge = nullptr, int maxRepairs = 3,
+  SignMode sign = SignMode::FloodFill, const TriangleTree* windingTree = nullptr);
 
 /// For display: xi sampled on a regular grid over the mesh's box plus a margin (spacing at least
 /// `minSpacing`, at most ~256 samples per axis), interior filled, exterior band wide enough to

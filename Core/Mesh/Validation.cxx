@@ -4,8 +4,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <sstream>
+#include <unordered_map>
 
 namespace sdfcage
 {
@@ -51,9 +53,7 @@ std::string MeshDefects::errorMessage() const
   if (BoundaryEdges)
   {
     sep();
-    s << "the mesh has " << BoundaryEdges
-      << " boundary edges: it must be closed (watertight); fill the holes first (e.g. "
-         "vtkFillHolesFilter / ParaView's Fill Holes) or reconstruct a watertight surface";
+    s << "the mesh has " << BoundaryEdges << " boundary edges (it is not closed)";
   }
   if (NonManifoldEdges)
   {
@@ -69,31 +69,67 @@ std::string MeshDefects::errorMessage() const
   if (DegenerateTriangles)
   {
     sep();
-    s << DegenerateTriangles
-      << " degenerate (zero-area) triangles: remove them first (e.g. vtkCleanPolyData with point "
-         "merging)";
+    s << DegenerateTriangles << " degenerate (zero-area) triangles";
   }
   if (InconsistentEdges)
   {
     sep();
-    s << InconsistentEdges
-      << " edges are used twice in the same direction: triangle orientation is inconsistent; "
-         "orient the mesh consistently first (e.g. vtkPolyDataNormals with ConsistencyOn)";
+    s << InconsistentEdges << " edges are used twice in the same direction (inconsistent orientation)";
   }
   std::string msg = s.str();
   if (!msg.empty())
   {
-    msg = "Unusable input mesh: " + msg + ".";
+    msg = "Unusable mesh: " + msg + ".";
   }
   return msg;
+}
+
+std::string MeshDefects::inputErrorMessage() const
+{
+  std::string msg;
+  auto add = [&](const std::string& part) { msg += (msg.empty() ? "" : "; ") + part; };
+  if (NonFinitePoints)
+  {
+    add(std::to_string(NonFinitePoints) + " points have non-finite (NaN or infinite) coordinates: fix or remove them");
+  }
+  if (InvalidPointIds)
+  {
+    add(std::to_string(InvalidPointIds) + " cells reference points that do not exist: the file is corrupt");
+  }
+  if (Empty && msg.empty())
+  {
+    add(DroppedDegenerateTriangles > 0
+        ? "the mesh has no triangles with a non-zero area (" + std::to_string(DroppedDegenerateTriangles) + " degenerate ones)"
+        : std::string("the mesh has no polygons (points or lines only, or nothing)"));
+  }
+  return msg.empty() ? msg : "Unusable input mesh: " + msg + ".";
 }
 
 std::vector<std::string> MeshDefects::warnings() const
 {
   std::vector<std::string> w;
+  if (MergedPoints)
+  {
+    w.push_back(std::to_string(MergedPoints) + " coincident points were merged (split seams or duplicated positions)");
+  }
   if (TriangulatedPolygons)
   {
     w.push_back(std::to_string(TriangulatedPolygons) + " polygons were split into triangles");
+  }
+  if (DroppedDegenerateTriangles)
+  {
+    w.push_back(std::to_string(DroppedDegenerateTriangles) + " degenerate (zero-area) triangles were dropped");
+  }
+  if (DroppedDuplicateTriangles)
+  {
+    w.push_back(std::to_string(DroppedDuplicateTriangles) + " duplicated triangles were dropped");
+  }
+  if (BoundaryEdges || NonManifoldEdges || NonManifoldVertices || InconsistentEdges)
+  {
+    w.push_back("the mesh is not a closed, consistently oriented 2-manifold (" + std::to_string(BoundaryEdges) +
+      " boundary edges, " + std::to_string(NonManifoldEdges) + " non-manifold edges, " +
+      std::to_string(NonManifoldVertices) + " non-manifold vertices, " + std::to_string(InconsistentEdges) +
+      " inconsistently oriented edges): its inside is taken from the generalized winding number");
   }
   if (IgnoredCells)
   {
@@ -160,6 +196,134 @@ bool triangulateConvex(const std::vector<Vec3>& pts, const std::int64_t* ids, st
     out.push_back({ static_cast<int>(ids[0]), static_cast<int>(ids[i]), static_cast<int>(ids[i + 1]) });
   }
   return true;
+}
+
+// Ear clipping of polygon ids (n >= 4) in the plane of its Newell normal; false when the
+// polygon has no area or no ear can be found (self-overlapping outline).
+bool triangulateEars(const std::vector<Vec3>& pts, const std::int64_t* ids, std::int64_t n, std::vector<Triangle>& out)
+{
+  Vec3 normal = Vec3::Zero();
+  for (std::int64_t i = 0; i < n; ++i)
+  {
+    normal += pts[ids[i]].cross(pts[ids[(i + 1) % n]]);
+  }
+  if (!(normal.norm() > 0.0))
+  {
+    return false;
+  }
+  int axis = 0;
+  normal.cwiseAbs().maxCoeff(&axis);
+  const int u = (axis + 1) % 3, v = (axis + 2) % 3;
+  const double orient = normal[axis] > 0 ? 1.0 : -1.0;
+  std::vector<std::array<double, 2>> q(static_cast<std::size_t>(n));
+  for (std::int64_t i = 0; i < n; ++i)
+  {
+    q[i] = { pts[ids[i]][u], pts[ids[i]][v] };
+  }
+  auto cross = [&](int a, int b, int c) {
+    return orient * ((q[b][0] - q[a][0]) * (q[c][1] - q[a][1]) - (q[b][1] - q[a][1]) * (q[c][0] - q[a][0]));
+  };
+  std::vector<int> next(n), prev(n);
+  for (int i = 0; i < n; ++i)
+  {
+    next[i] = static_cast<int>((i + 1) % n);
+    prev[i] = static_cast<int>((i + n - 1) % n);
+  }
+  std::vector<Triangle> tris;
+  int remaining = static_cast<int>(n);
+  int i = 0;
+  int sinceLastEar = 0;
+  while (remaining > 3)
+  {
+    const int a = prev[i], b = i, c = next[i];
+    bool ear = cross(a, b, c) > 0.0;
+    for (int k = next[c]; ear && k != a; k = next[k])
+    {
+      // a point of the outline inside (or on) the candidate ear blocks it
+      ear = !(cross(a, b, k) >= 0.0 && cross(b, c, k) >= 0.0 && cross(c, a, k) >= 0.0);
+    }
+    if (ear)
+    {
+      tris.push_back({ static_cast<int>(ids[a]), static_cast<int>(ids[b]), static_cast<int>(ids[c]) });
+      next[a] = c;
+      prev[c] = a;
+      --remaining;
+      i = a;
+      sinceLastEar = 0;
+    }
+    else
+    {
+      i = c;
+      if (++sinceLastEar > remaining)
+      {
+        return false;
+      }
+    }
+  }
+  tris.push_back({ static_cast<int>(ids[prev[i]]), static_cast<int>(ids[i]), static_cast<int>(ids[next[i]]) });
+  out.insert(out.end(), tris.begin(), tris.end());
+  return true;
+}
+
+// Maps every referenced point to the first earlier referenced point within `tol` (per
+// coordinate), on a hashed grid of cells of size tol; returns the number of merged points.
+std::int64_t mergeCoincidentPoints(const std::vector<Vec3>& pts, const std::vector<char>& referenced, const Vec3& origin,
+  double tol, std::vector<std::int64_t>& representative)
+{
+  const std::size_t np = pts.size();
+  representative.resize(np);
+  std::iota(representative.begin(), representative.end(), 0);
+  if (!(tol > 0.0))
+  {
+    return 0;
+  }
+  // cells counted from the box corner: at most diagonal / tol = 1e9 per axis, no overflow
+  auto cell = [&](double x) { return static_cast<std::int64_t>(std::floor(x / tol)); };
+  auto key = [](std::int64_t x, std::int64_t y, std::int64_t z) {
+    return (static_cast<std::uint64_t>(x) * 73856093ULL) ^ (static_cast<std::uint64_t>(y) * 19349663ULL) ^
+      (static_cast<std::uint64_t>(z) * 83492791ULL);
+  };
+  std::unordered_map<std::uint64_t, std::vector<std::int64_t>> grid;
+  grid.reserve(np);
+  std::int64_t merged = 0;
+  for (std::size_t i = 0; i < np; ++i)
+  {
+    if (!referenced[i])
+    {
+      continue;
+    }
+    const Vec3& p = pts[i];
+    const Vec3 rel = p - origin;
+    const std::int64_t cx = cell(rel.x()), cy = cell(rel.y()), cz = cell(rel.z());
+    std::int64_t found = -1;
+    const int reach = 1;
+    for (int dx = -reach; dx <= reach && found < 0; ++dx)
+      for (int dy = -reach; dy <= reach && found < 0; ++dy)
+        for (int dz = -reach; dz <= reach && found < 0; ++dz)
+        {
+          const auto it = grid.find(key(cx + dx, cy + dy, cz + dz));
+          if (it == grid.end())
+            continue;
+          for (std::int64_t j : it->second)
+          {
+            if ((pts[j] - p).cwiseAbs().maxCoeff() <= tol)
+            {
+              found = j;
+              break;
+            }
+          }
+        }
+    if (found >= 0)
+    {
+      representative[i] = found;
+      ++merged;
+    }
+    else
+    {
+      grid[key(cx, cy, cz)].push_back(static_cast<std::int64_t>(i));
+    }
+  }
+  return merged;
 }
 
 struct HalfEdge
@@ -315,14 +479,13 @@ MeshDefects prepareMesh(const PolygonMesh& input, TriangleMesh& output, const Va
   const std::int64_t np = static_cast<std::int64_t>(input.Points.size());
   const std::size_t nc = input.numberOfCells();
 
-  // 1. cells -> triangles
-  output.Triangles.reserve(nc);
+  // 1. which points the surface cells use; cells with invalid ids are counted (fatal)
   std::vector<char> referenced(np, 0);
+  std::vector<char> cellValid(nc, 0);
   for (std::size_t c = 0; c < nc; ++c)
   {
     const std::int64_t b = input.Offsets[c], e = input.Offsets[c + 1];
-    const std::int64_t n = e - b;
-    if (n < 3)
+    if (e - b < 3)
     {
       ++d.IgnoredCells;
       continue;
@@ -331,73 +494,160 @@ MeshDefects prepareMesh(const PolygonMesh& input, TriangleMesh& output, const Va
     for (std::int64_t k = b; k < e; ++k)
     {
       const std::int64_t id = input.Connectivity[k];
-      if (id < 0 || id >= np)
-      {
-        valid = false;
-      }
+      valid = valid && id >= 0 && id < np;
     }
     if (!valid)
     {
       ++d.InvalidPointIds;
       continue;
     }
+    cellValid[c] = 1;
     for (std::int64_t k = b; k < e; ++k)
     {
       referenced[input.Connectivity[k]] = 1;
     }
-    if (n == 3)
-    {
-      output.Triangles.push_back({ static_cast<int>(input.Connectivity[b]),
-        static_cast<int>(input.Connectivity[b + 1]), static_cast<int>(input.Connectivity[b + 2]) });
-    }
-    else if (triangulateConvex(input.Points, &input.Connectivity[b], n, output.Triangles))
-    {
-      ++d.TriangulatedPolygons;
-    }
-    else
-    {
-      ++d.UntriangulatedPolygons;
-    }
   }
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   for (std::int64_t i = 0; i < np; ++i)
   {
-    if (referenced[i] && !input.Points[i].allFinite())
-    {
-      ++d.NonFinitePoints;
-    }
     if (!referenced[i])
     {
       ++d.UnreferencedPoints;
     }
+    else if (!input.Points[i].allFinite())
+    {
+      ++d.NonFinitePoints;
+    }
+    else
+    {
+      lo = lo.cwiseMin(input.Points[i]);
+      hi = hi.cwiseMax(input.Points[i]);
+    }
+  }
+  if (d.NonFinitePoints || d.InvalidPointIds)
+  {
+    d.Empty = true;
+    return d; // geometry cannot be trusted further
+  }
+
+  // 2. coincident points merged (split seams, STL facet corners, duplicated scan points)
+  std::vector<std::int64_t> rep;
+  const double diagonal = (hi - lo).allFinite() ? (hi - lo).norm() : 0.0;
+  d.MergeTolerance = options.MergeTolerance >= 0.0 ? options.MergeTolerance * diagonal : -1.0;
+  d.MergedPoints = mergeCoincidentPoints(input.Points, referenced, lo, d.MergeTolerance, rep);
+  auto id = [&](std::int64_t k) { return static_cast<int>(rep[input.Connectivity[k]]); };
+
+  // 3. cells -> triangles: convex planar polygons by a fan (as before), others by ear clipping
+  // in their plane, a fan when even that fails (a self-overlapping outline)
+  output.Triangles.reserve(nc);
+  std::vector<std::int64_t> ring;
+  for (std::size_t c = 0; c < nc; ++c)
+  {
+    if (!cellValid[c])
+    {
+      continue;
+    }
+    const std::int64_t b = input.Offsets[c], e = input.Offsets[c + 1];
+    const std::int64_t n = e - b;
+    if (n == 3)
+    {
+      output.Triangles.push_back({ id(b), id(b + 1), id(b + 2) });
+      continue;
+    }
+    ring.clear();
+    for (std::int64_t k = b; k < e; ++k)
+    {
+      if (ring.empty() || rep[input.Connectivity[k]] != ring.back())
+      {
+        ring.push_back(rep[input.Connectivity[k]]);
+      }
+    }
+    while (ring.size() > 1 && ring.front() == ring.back())
+    {
+      ring.pop_back();
+    }
+    const std::int64_t m = static_cast<std::int64_t>(ring.size());
+    ++d.TriangulatedPolygons;
+    if (m < 3)
+    {
+      ++d.DroppedDegenerateTriangles;
+      continue;
+    }
+    if (m == 3)
+    {
+      output.Triangles.push_back({ static_cast<int>(ring[0]), static_cast<int>(ring[1]), static_cast<int>(ring[2]) });
+    }
+    else if (!triangulateConvex(input.Points, ring.data(), m, output.Triangles) &&
+      !triangulateEars(input.Points, ring.data(), m, output.Triangles))
+    {
+      for (std::int64_t k = 1; k + 1 < m; ++k)
+      {
+        output.Triangles.push_back({ static_cast<int>(ring[0]), static_cast<int>(ring[k]), static_cast<int>(ring[k + 1]) });
+      }
+    }
+  }
+
+  // 4. degenerate (area relative to the squared bounding-box diagonal) and duplicated triangles
+  // dropped
+  {
+    const double tol = options.DegenerateAreaTolerance * diagonal * diagonal;
+    std::vector<Triangle> kept;
+    kept.reserve(output.Triangles.size());
+    for (const Triangle& t : output.Triangles)
+    {
+      const Vec3 n = (input.Points[t[1]] - input.Points[t[0]]).cross(input.Points[t[2]] - input.Points[t[0]]);
+      if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || 0.5 * n.norm() <= tol)
+      {
+        ++d.DroppedDegenerateTriangles;
+      }
+      else
+      {
+        kept.push_back(t);
+      }
+    }
+    // duplicates: the same three points in any order (the first one is kept)
+    std::vector<std::pair<std::array<int, 3>, int>> sorted(kept.size());
+    for (std::size_t f = 0; f < kept.size(); ++f)
+    {
+      std::array<int, 3> k = kept[f];
+      std::sort(k.begin(), k.end());
+      sorted[f] = { k, static_cast<int>(f) };
+    }
+    std::sort(sorted.begin(), sorted.end());
+    std::vector<char> duplicate(kept.size(), 0);
+    for (std::size_t i = 1; i < sorted.size(); ++i)
+    {
+      if (sorted[i].first == sorted[i - 1].first)
+      {
+        duplicate[sorted[i].second] = 1;
+        ++d.DroppedDuplicateTriangles;
+      }
+    }
+    output.Triangles.clear();
+    for (std::size_t f = 0; f < kept.size(); ++f)
+    {
+      if (!duplicate[f])
+      {
+        output.Triangles.push_back(kept[f]);
+      }
+    }
   }
   d.Empty = output.Triangles.empty();
-  if (d.Empty || d.NonFinitePoints || d.InvalidPointIds)
+  if (d.Empty)
   {
-    return d; // geometry cannot be trusted further
+    return d;
   }
   output.Points = input.Points;
   removeUnreferencedPoints(output);
-
-  // 2. degenerate triangles (area relative to the squared bounding-box diagonal)
-  const auto box = bounds(output);
-  const double diag2 = (box[1] - box[0]).squaredNorm();
-  const double tol = options.DegenerateAreaTolerance * diag2;
-  for (const Triangle& t : output.Triangles)
-  {
-    const Vec3 n = (output.Points[t[1]] - output.Points[t[0]]).cross(output.Points[t[2]] - output.Points[t[0]]);
-    if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || 0.5 * n.norm() <= tol)
-    {
-      ++d.DegenerateTriangles;
-    }
-  }
+  d.UnreferencedPoints = static_cast<std::int64_t>(input.Points.size() - output.Points.size()) - d.MergedPoints;
 
   // 3. topology
   checkTopology(output, d);
   std::vector<int> comp;
   d.Components = triangleComponents(output, comp);
-  if (!d.usable())
+  if (!d.closedManifold())
   {
-    return d;
+    return d; // no orientation to fix, no genus: the winding number decides the inside
   }
 
   // 4. orientation per component: a component with negative volume faces inward, unless it is a

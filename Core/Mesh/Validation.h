@@ -1,4 +1,5 @@
-// SDFCage — Core: turn a user's polygon mesh into a usable closed triangle mesh, or say why not.
+// SDFCage — Core: turn a user's polygon mesh into a triangle mesh the pipeline can cage (repairing
+// what can be repaired and counting it), or say why not.
 #pragma once
 
 #include "Mesh/Mesh.h"
@@ -10,33 +11,52 @@
 namespace sdfcage
 {
 
-/// Counts of everything validation found. A mesh is usable when none of the fatal counts is
-/// non-zero (see usable()).
+/// Counts of everything validation found and repaired.
+///
+/// Any input with at least one usable triangle gets through prepareMesh (usableAsInput()):
+/// coincident points are merged, every polygon is triangulated, degenerate and duplicated
+/// triangles are dropped, all of it counted. What is left decides how the inside is chosen
+/// (see SignMode in Envelope/Envelope.h): a closed, consistently oriented 2-manifold
+/// (closedManifold()) keeps the flood-fill path; anything else (boundary edges, non-manifold
+/// edges or vertices, inconsistent orientation) goes through the generalized winding number.
 struct MeshDefects
 {
-  // fatal
-  bool Empty = false;                     ///< no triangles after conversion
+  // fatal for an input (the file cannot be trusted), and for a cage
+  bool Empty = false;                     ///< no triangles after conversion and repair
   std::int64_t NonFinitePoints = 0;       ///< referenced points with NaN/Inf coordinates
   std::int64_t InvalidPointIds = 0;       ///< cell references outside the point list
-  std::int64_t UntriangulatedPolygons = 0; ///< polygons that could not be split safely
+  // fatal for a cage (usable()), reported and handled for an input
+  std::int64_t UntriangulatedPolygons = 0; ///< polygons that could not be split (always 0 from prepareMesh)
   std::int64_t BoundaryEdges = 0;         ///< edges with one incident triangle (not closed)
   std::int64_t NonManifoldEdges = 0;      ///< edges with more than two incident triangles
   std::int64_t NonManifoldVertices = 0;   ///< vertices whose triangle fan is not one disk
-  std::int64_t DegenerateTriangles = 0;   ///< zero-area triangles (repeated or collinear points)
+  std::int64_t DegenerateTriangles = 0;   ///< zero-area triangles left (prepareMesh drops them: 0)
   std::int64_t InconsistentEdges = 0;     ///< edges used twice in the same direction
-  // informative
+  // repairs of an input (informative)
+  std::int64_t MergedPoints = 0;          ///< points merged into a coincident one (split seams)
+  double MergeTolerance = 0.0;            ///< the merge distance used (input units)
   std::int64_t TriangulatedPolygons = 0;  ///< quads/polygons split into triangles
+  std::int64_t DroppedDegenerateTriangles = 0; ///< zero-area triangles dropped
+  std::int64_t DroppedDuplicateTriangles = 0;  ///< repeated triangles (same three points) dropped
   std::int64_t IgnoredCells = 0;          ///< vertex and line cells (not surfaces)
   std::int64_t UnreferencedPoints = 0;    ///< points no triangle uses (dropped)
   int Components = 0;                     ///< connected components (several are allowed)
-  int Genus = 0;                          ///< total genus (valid when usable)
+  int Genus = 0;                          ///< total genus (valid when closedManifold())
   bool FlippedOrientation = false;        ///< the closed mesh was inward and was flipped
 
+  /// Strict: a closed, consistently oriented 2-manifold without degenerate triangles (what an
+  /// envelope and a cage must be, and the input of the flood-fill path).
   bool usable() const;
-  /// One actionable sentence per fatal defect, e.g. "the mesh has 12 boundary edges: it must be
-  /// closed (watertight); fill holes first, e.g. with vtkFillHolesFilter".
+  bool closedManifold() const { return usable(); }
+  /// An input that can be caged: at least one triangle, finite points, valid ids.
+  bool usableAsInput() const { return !Empty && NonFinitePoints == 0 && InvalidPointIds == 0; }
+  /// One actionable sentence per defect that usable() rejects, e.g. "the mesh has 12 boundary
+  /// edges (it is not closed)".
   std::string errorMessage() const;
-  /// Non-fatal notes (triangulation, flipped orientation, ignored cells).
+  /// The same for what usableAsInput() rejects (empty when it accepts).
+  std::string inputErrorMessage() const;
+  /// Notes on what was repaired or found (merged points, triangulation, dropped triangles,
+  /// ignored cells, flipped orientation, boundary and non-manifold edges).
   std::vector<std::string> warnings() const;
 };
 
@@ -45,12 +65,18 @@ struct ValidationOptions
   /// Relative area threshold (to the squared bounding-box diagonal) under which a triangle counts
   /// as degenerate. 0 means exactly zero area only.
   double DegenerateAreaTolerance = 0.0;
+  /// Points closer than this (relative to the bounding-box diagonal, per coordinate) are merged:
+  /// far below any voxel size (1e-9 against 0.005 of the unit sphere), it only joins positions
+  /// that are the same up to rounding, such as the split seams of a textured OBJ, an STL's
+  /// separate facet corners or a scan's duplicated points. Negative: no merging.
+  double MergeTolerance = 1e-9;
 };
 
-/// Validates and converts: triangulates polygons where safe (convex, planar within tolerance),
-/// ignores vertex/line cells, drops unreferenced points, checks closedness, manifoldness,
-/// degeneracy and orientation consistency, and flips an inward-oriented mesh.
-/// `output` is valid only when the returned defects are usable().
+/// Validates, converts and repairs: merges coincident points, triangulates every polygon
+/// (convex planar ones by a fan as before, others by ear clipping in their best-fit plane),
+/// drops degenerate and duplicated triangles and unreferenced points, ignores vertex/line cells,
+/// measures closedness, manifoldness and orientation consistency, and flips a closed
+/// inward-oriented mesh. `output` is valid when the returned defects are usableAsInput().
 MeshDefects prepareMesh(const PolygonMesh& input, TriangleMesh& output,
   const ValidationOptions& options = ValidationOptions());
 

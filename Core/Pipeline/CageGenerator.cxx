@@ -47,18 +47,11 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
   TriangleMesh mesh;
   result.Defects = prepareMesh(input, mesh, options.Validation);
   result.ValidationSeconds = seconds(start);
-  if (result.Defects.Empty && result.Defects.usable() == false &&
-    result.Defects.NonFinitePoints == 0 && result.Defects.InvalidPointIds == 0 &&
-    result.Defects.UntriangulatedPolygons == 0)
+  if (!result.Defects.usableAsInput())
   {
-    result.State = Status::EmptyInput;
-    result.Message = "the input has no triangles";
-    return result;
-  }
-  if (!result.Defects.usable())
-  {
-    result.State = Status::InvalidInput;
-    result.Message = result.Defects.errorMessage();
+    const bool nothing = result.Defects.Empty && result.Defects.NonFinitePoints == 0 && result.Defects.InvalidPointIds == 0;
+    result.State = nothing ? Status::EmptyInput : Status::InvalidInput;
+    result.Message = result.Defects.inputErrorMessage();
     return result;
   }
   if (progressCancelled(progress))
@@ -78,7 +71,12 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
   EnvelopeOptions envelopeOptions = options.Envelope;
   envelopeOptions.ExactEnvelopeClearance = envelopeOptions.ExactEnvelopeClearance || options.TargetNumberOfVertices <= 0;
   EnvelopeResult env =
-    buildEnvelope(unit, envelopeOptions, progress, options.TargetNumberOfVertices > 0 ? 0.45 : 1.0);
+    buildEnvelope(unit, envelopeOptions, progress, options.TargetNumberOfVertices > 0 ? 0.45 : 1.0,
+      result.Defects.usable() ? 1 : 0);
+  result.SignUsed = env.SignUsed;
+  result.SignReason = env.SignReason;
+  result.InputClosed = env.InputClosed;
+  result.WindingSeconds = env.WindingSeconds;
   result.DistanceFieldSeconds = env.DistanceFieldSeconds;
   result.IsosurfaceSeconds = env.IsosurfaceSeconds;
   result.VerificationSeconds = env.VerificationSeconds;

@@ -40,8 +40,12 @@ struct CageResult
   int EnvelopeGenus = 0;
   int EnvelopeComponents = 0;
   double VoxelSizeUsed = 0.0;       ///< unit-sphere units
-  int InputGenus = 0;
+  int InputGenus = 0;               ///< -1 where undefined (the input is not closed)
   int InputComponents = 0;
+  bool InputClosed = false;         ///< closed, consistently oriented 2-manifold (after repair)
+  SignMode SignUsed = SignMode::FloodFill; ///< how the inside was decided (never Auto)
+  std::string SignReason;           ///< why
+  double WindingSeconds = 0.0;      ///< winding-number sign, part of DistanceFieldSeconds
   std::size_t NumberOfActivePoints = 0;  ///< input points flagged active (0 when off)
   std::size_t NumberOfActiveSamples = 0; ///< the active set A on the surface sampling
   double ActivePointSeconds = 0.0;

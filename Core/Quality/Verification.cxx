@@ -217,14 +217,17 @@ bool verifyEnclosure(const TriangleMesh& input, const TriangleMesh& cage, double
       probe[comp[f]] = input.Triangles[f][0];
     }
   }
-  int outside = 0;
-  for (int c = 0; c < ncomp; ++c)
-  {
-    if (windingNumber(cage, input.Points[probe[c]]) < 0.5)
-    {
-      ++outside;
-    }
-  }
+  // one probe per component, in parallel (soups have many components)
+  const int outside = tbb::parallel_reduce(
+    tbb::blocked_range<int>(0, ncomp, 1), 0,
+    [&](const tbb::blocked_range<int>& r, int count) {
+      for (int c = r.begin(); c != r.end(); ++c)
+      {
+        count += windingNumber(cage, input.Points[probe[c]]) < 0.5;
+      }
+      return count;
+    },
+    [](int a, int b) { return a + b; });
   progressUpdate(progress, 1.0);
   if (outside > 0)
   {

@@ -364,4 +364,103 @@ void TriangleTree::trianglesWithin(const Vec3 t[3], double radius, std::vector<i
   this->triangleQuery(t, radius, false, &ids);
 }
 
+void TriangleTree::prepareWindingNumbers()
+{
+  Dipoles.assign(Nodes.size(), Dipole());
+  // Nodes are in pre-order (children after their parent): leaves first, then parents from the
+  // back. Leaves are independent and computed in parallel.
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, Nodes.size(), 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i)
+    {
+      const Node& node = Nodes[i];
+      if (node.Left >= 0)
+      {
+        continue;
+      }
+      Dipole& d = Dipoles[i];
+      Vec3 weighted = Vec3::Zero();
+      Vec3 mean = Vec3::Zero();
+      for (int k = node.Start; k < node.Start + node.Count; ++k)
+      {
+        const Vec3* P = Tri[k].P;
+        const Vec3 an = 0.5 * (P[1] - P[0]).cross(P[2] - P[0]);
+        const double a = an.norm();
+        d.AreaNormal += an;
+        d.Area += a;
+        weighted += a * (P[0] + P[1] + P[2]) / 3.0;
+        mean += (P[0] + P[1] + P[2]) / 3.0;
+      }
+      d.Center = d.Area > 0 ? Vec3(weighted / d.Area) : Vec3(mean / std::max(1, node.Count));
+      for (int k = node.Start; k < node.Start + node.Count; ++k)
+      {
+        for (const Vec3& q : Tri[k].P)
+        {
+          d.Radius = std::max(d.Radius, (q - d.Center).norm());
+        }
+      }
+    }
+  });
+  for (std::size_t i = Nodes.size(); i-- > 0;)
+  {
+    const Node& node = Nodes[i];
+    if (node.Left < 0)
+    {
+      continue;
+    }
+    const Dipole& l = Dipoles[node.Left];
+    const Dipole& r = Dipoles[node.Right];
+    Dipole& d = Dipoles[i];
+    d.Area = l.Area + r.Area;
+    d.AreaNormal = l.AreaNormal + r.AreaNormal;
+    d.Center = d.Area > 0 ? Vec3((l.Area * l.Center + r.Area * r.Center) / d.Area) : Vec3(0.5 * (l.Center + r.Center));
+    d.Radius = std::max((l.Center - d.Center).norm() + l.Radius, (r.Center - d.Center).norm() + r.Radius);
+  }
+}
+
+double TriangleTree::windingNumber(const Vec3& p, double beta) const
+{
+  if (Nodes.empty() || Dipoles.size() != Nodes.size())
+  {
+    return 0.0;
+  }
+  double total = 0.0; // sum of solid angles
+  int stack[128];
+  int top = 0;
+  stack[top++] = 0;
+  while (top > 0)
+  {
+    const int i = stack[--top];
+    const Node& node = Nodes[i];
+    const Dipole& d = Dipoles[i];
+    const Vec3 r = d.Center - p;
+    const double dist = r.norm();
+    if (dist > beta * d.Radius && dist > 0.0)
+    {
+      total += d.AreaNormal.dot(r) / (dist * dist * dist); // far: one dipole
+      continue;
+    }
+    if (node.Left < 0)
+    {
+      for (int k = node.Start; k < node.Start + node.Count; ++k)
+      {
+        // exact solid angle (Van Oosterom & Strackee)
+        const Vec3 a = Tri[k].P[0] - p, b = Tri[k].P[1] - p, c = Tri[k].P[2] - p;
+        const double la = a.norm(), lb = b.norm(), lc = c.norm();
+        const double num = a.dot(b.cross(c));
+        const double den = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+        total += 2.0 * std::atan2(num, den);
+      }
+      continue;
+    }
+    if (top + 2 > 128)
+    {
+      total += d.AreaNormal.dot(r) / std::max(dist * dist * dist, 1e-300); // depth cap (never reached: depth <= 61)
+      continue;
+    }
+    stack[top++] = node.Left;
+    stack[top++] = node.Right;
+  }
+  return total / (4.0 * M_PI);
+}
+
 } // namespace sdfcage

@@ -183,7 +183,7 @@ vtkSmartPointer<vtkPolyData> readMesh(const std::string& path, std::string& erro
   if (mesh->GetNumberOfPolys() + mesh->GetNumberOfStrips() == 0)
   {
     error = "'" + path + "' contains no polygons (" + std::to_string(mesh->GetNumberOfPoints()) +
-      " points): a closed surface mesh is needed";
+      " points): a surface mesh is needed (for a point cloud, reconstruct a surface first)";
     return nullptr;
   }
   // Keep our own copy, detached from the reader.

@@ -143,6 +143,16 @@ std::string toJson(const RunReport& r)
   key("NumberOfActivePoints") << r.NumberOfActivePoints;
   key("ActivePointTime") << jsonNumber(r.ActivePointTime);
   key("TopologyWarning") << jsonString(r.TopologyWarning);
+  key("RequestedSignMode") << jsonString(r.Sign);
+  for (const sdfcage::ResultField& f : r.InputResults)
+  {
+    if (f.Type == sdfcage::ResultField::Kind::Text)
+      key(f.Name.c_str()) << jsonString(f.Text);
+    else if (f.Type == sdfcage::ResultField::Kind::Real)
+      key(f.Name.c_str()) << jsonNumber(f.Real);
+    else
+      key(f.Name.c_str()) << f.Integer;
+  }
   os << "\n}\n";
   return os.str();
 }
@@ -181,6 +191,26 @@ void printSummary(std::ostream& os, const RunReport& r)
   if (!r.FilterRan)
   {
     return;
+  }
+  auto field = [&](const char* name) -> const sdfcage::ResultField* {
+    for (const sdfcage::ResultField& f : r.InputResults)
+      if (f.Name == name)
+        return &f;
+    return nullptr;
+  };
+  auto count = [&](const char* name) { const auto* f = field(name); return f ? f->Integer : 0LL; };
+  auto text = [&](const char* name) { const auto* f = field(name); return f ? f->Text : std::string(); };
+  if (!r.InputResults.empty())
+  {
+    os << "repairs     : " << count("MergedPoints") << " points merged, " << count("TriangulatedPolygons")
+       << " polygons triangulated, " << count("DroppedDegenerateTriangles") << " degenerate and "
+       << count("DroppedDuplicateTriangles") << " duplicated triangles dropped\n";
+    os << "inside rule : " << text("SignMode") << " (" << text("SignReason") << "); " << count("InputComponents")
+       << " component(s), " << count("InputBoundaryEdges") << " boundary edges, " << count("InputNonManifoldEdges")
+       << " non-manifold edges, " << count("InputNonManifoldVertices") << " non-manifold vertices";
+    if (count("InputClosed"))
+      os << ", genus " << count("InputGenus");
+    os << "\n";
   }
   if (r.UseActivePoints)
   {

@@ -1,8 +1,11 @@
 // SDFCage — CLI: what one run did, as a text summary and as a JSON report.
 #pragma once
 
+#include "Pipeline/Results.h"
+
 #include <ostream>
 #include <string>
+#include <vector>
 
 namespace sdfcage_cli
 {
@@ -24,6 +27,7 @@ struct RunReport
   int TargetNumberOfVertices = 0; ///< the target (0 = no simplification)
   int MaximumRefinements = 0;
   std::string Optimize = "none"; ///< none, mips or spacing
+  std::string Sign = "auto";     ///< the inside rule asked for (SignMode has the one used)
   double TargetSpacing = 0.0;
   int NumberOfIterations = 0;
   int NumberOfThreads = 0;
@@ -69,6 +73,9 @@ struct RunReport
   long long NumberOfActivePoints = 0; ///< input points found active
   double ActivePointTime = 0.0;
   std::string TopologyWarning; ///< set when the envelope's genus/components differ from the input's
+  /// What was done to the input and how its inside was decided (Core's inputResults table,
+  /// read back from the filter by name): JSON keys and summary lines come from it.
+  std::vector<sdfcage::ResultField> InputResults;
   bool FilterRan = false; ///< false when the run stopped before the filter (e.g. unreadable)
 
   // outcome

@@ -1,7 +1,7 @@
-// SDFCage — the command-line program: a closed mesh (or the built-in shape) -> its cage.
+// SDFCage — the command-line program: a surface mesh (or the built-in shape) -> its cage.
 //
 //   sdfcage [INPUT] [-o OUT] [-n N] [--iso C] [--voxel H] [--clearance D] [--adaptivity A]
-//           [--refinements N] [--no-active-points] [--active-radius R] [--geodesic-threshold L]
+//           [--refinements N] [--sign auto|flood|winding|unsigned] [--no-active-points] [--active-radius R] [--geodesic-threshold L]
 //           [--alpha A] [--beta B] [--optimize none|mips|spacing] [--spacing H] [--iterations K]
 //           [--report FILE.json] [--screenshot FILE.png] [--threads N] [--quiet] [--help]
 //           [--version]
@@ -17,6 +17,7 @@
 #include "CLIScreenshot.h"
 
 #include "Envelope/Envelope.h" // sdfcage::EnvelopeOptions: what "0 = automatic" resolves to
+#include "Pipeline/CageGenerator.h" // sdfcage::CageResult, for the names of the result table
 
 #include <vtkSDFCageFilter.h>
 
@@ -66,7 +67,8 @@ void printUsage(std::ostream& os)
         "       sdfcage --check INPUT CAGE [--report FILE.json] [--quiet]\n"
         "\n"
         "Builds a cage (a coarse closed mesh that strictly encloses the input) from an SDF\n"
-        "envelope, simplified to N vertices, and verifies it. INPUT is a closed mesh file\n"
+        "envelope, simplified to N vertices, and verifies it. INPUT is a surface mesh file\n"
+        "(closed or not: open scans, soups of parts, quads and polygons are repaired and caged)\n"
         "("
      << supportedExtensions()
      << ").\n"
@@ -87,6 +89,10 @@ void printUsage(std::ostream& os)
         "      --adaptivity A      isosurface adaptivity in [0, 1]: 0 uniform triangles, larger\n"
         "                          merges flat regions (fewer triangles); default 0.3\n"
         "      --refinements N     times the grid may be refined if verification fails, default 2\n"
+        "      --sign S            how the inside of the input is decided: auto (default: flood for\n"
+        "                          a closed, consistently oriented mesh, winding otherwise), flood,\n"
+        "                          winding (generalized winding number: holes bridged, sheets\n"
+        "                          wrapped on both sides) or unsigned (every sheet wrapped)\n"
         "      --no-active-points  plain offset envelope: no active points, no amplified SDF\n"
         "                          (nearly touching parts may fuse)\n"
         "      --active-radius R   active points: another surface point closer than R in space,\n"
@@ -136,6 +142,7 @@ struct Options
   double Alpha = -1.0;             ///< -1 = the filter's default
   double Beta = -1.0;              ///< -1 = the filter's default
   std::string Optimize = "none"; ///< none, mips or spacing
+  std::string Sign = "auto";     ///< auto, flood, winding or unsigned
   double Spacing = -1.0;         ///< -1 = the filter's default
   int Iterations = -1;           ///< -1 = the filter's default
   int Threads = 0;
@@ -333,6 +340,14 @@ Options parseOptions(int argc, char* argv[], vtkSDFCageFilter* limits)
     {
       o.Beta = parseDouble(
         arg, takeValue(), limits->GetAmplificationBetaMinValue(), limits->GetAmplificationBetaMaxValue());
+    }
+    else if (arg == "--sign")
+    {
+      o.Sign = takeValue();
+      if (o.Sign != "auto" && o.Sign != "flood" && o.Sign != "winding" && o.Sign != "unsigned")
+      {
+        throw UsageError{ "--sign expects auto, flood, winding or unsigned, got '" + o.Sign + "'" };
+      }
     }
     else if (arg == "--optimize")
     {
@@ -665,6 +680,8 @@ int run(const Options& o, MessageCollector* messages)
   r.TargetNumberOfVertices = filter->GetTargetNumberOfVertices();
   r.MaximumRefinements = filter->GetMaximumRefinements();
   filter->SetNumberOfThreads(o.Threads);
+  filter->SetSignMode(o.Sign == "flood" ? 1 : o.Sign == "winding" ? 2 : o.Sign == "unsigned" ? 3 : 0);
+  r.Sign = o.Sign;
   filter->AddObserver(vtkCommand::ProgressEvent, progress);
   std::signal(SIGINT, onInterrupt);
   filter->Update();
@@ -699,6 +716,16 @@ int run(const Options& o, MessageCollector* messages)
   r.NumberOfActivePoints = filter->GetNumberOfActivePoints();
   r.ActivePointTime = filter->GetActivePointTime();
   r.TopologyWarning = filter->GetTopologyWarning();
+  r.InputResults = sdfcage::inputResults(sdfcage::CageResult()); // the names and kinds
+  for (sdfcage::ResultField& f : r.InputResults)
+  {
+    if (f.Type == sdfcage::ResultField::Kind::Text)
+      f.Text = filter->GetResultText(f.Name.c_str());
+    else if (f.Type == sdfcage::ResultField::Kind::Real)
+      f.Real = filter->GetResultNumber(f.Name.c_str());
+    else
+      f.Integer = static_cast<long long>(filter->GetResultNumber(f.Name.c_str()));
+  }
   r.CagePoints = cage ? cage->GetNumberOfPoints() : 0;
   r.CageTriangles = cage ? triangleCount(cage) : 0;
   r.EnvelopePoints = envelope ? envelope->GetNumberOfPoints() : 0;
