@@ -151,9 +151,9 @@ int vtkCageOptimizeFilter::RequestData(vtkInformation* vtkNotUsed(request),
       return fail(StatusIdentifier(sdfcage::Status::InvalidInput), "The cage (input 0) is not usable: " + dc.errorMessage());
     }
     const sdfcage::MeshDefects ds = sdfcage::prepareMesh(sourcePolygons, sourceMesh);
-    if (!ds.usable())
+    if (!ds.usableAsInput()) // open and soup sources are fine, as for the cage filter
     {
-      return fail(StatusIdentifier(sdfcage::Status::InvalidInput), "The source mesh (input 1) is not usable: " + ds.errorMessage());
+      return fail(StatusIdentifier(sdfcage::Status::InvalidInput), "The source mesh (input 1) is not usable: " + ds.inputErrorMessage());
     }
 
     sdfcage::OptimizeOptions options;

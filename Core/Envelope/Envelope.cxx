@@ -70,35 +70,61 @@ TriangleMesh outerBoundary(const TriangleMesh& surface, int& removed)
   {
     keepComponent[c] = volume[c] > 0.0;
   }
-  // nested positive components (a part inside a cavity of another part)
+  // nested positive components (a part inside a cavity of another part). Each component's
+  // triangles are listed once and a component can only be inside another whose box holds its
+  // probe vertex; the components are tested in parallel (soups give many).
   int positive = static_cast<int>(std::count(keepComponent.begin(), keepComponent.end(), 1));
   if (positive > 1)
   {
-    for (int c = 0; c < n; ++c)
+    std::vector<std::vector<int>> trianglesOf(n);
+    std::vector<Vec3> lo(n, Vec3::Constant(std::numeric_limits<double>::infinity()));
+    std::vector<Vec3> hi(n, Vec3::Constant(-std::numeric_limits<double>::infinity()));
+    for (std::size_t f = 0; f < surface.Triangles.size(); ++f)
     {
-      if (!keepComponent[c])
+      const int c = comp[f];
+      trianglesOf[c].push_back(static_cast<int>(f));
+      for (int i : surface.Triangles[f])
       {
-        continue;
+        lo[c] = lo[c].cwiseMin(surface.Points[i]);
+        hi[c] = hi[c].cwiseMax(surface.Points[i]);
       }
-      for (int o = 0; o < n; ++o)
+    }
+    // the generalized winding number of component o at p (the same sum as windingNumber())
+    auto windingOf = [&](int o, const Vec3& p) {
+      double total = 0.0;
+      for (int f : trianglesOf[o])
       {
-        if (o == c || volume[o] <= 0.0)
+        const Triangle& t = surface.Triangles[f];
+        const Vec3 a = surface.Points[t[0]] - p, b = surface.Points[t[1]] - p, c = surface.Points[t[2]] - p;
+        const double la = a.norm(), lb = b.norm(), lc = c.norm();
+        const double num = a.dot(b.cross(c));
+        const double den = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
+        total += 2.0 * std::atan2(num, den);
+      }
+      return total / (4.0 * M_PI);
+    };
+    tbb::parallel_for(tbb::blocked_range<int>(0, n, 1), [&](const tbb::blocked_range<int>& range) {
+      for (int c = range.begin(); c != range.end(); ++c)
+      {
+        if (!keepComponent[c])
         {
           continue;
         }
-        std::vector<char> k(surface.Triangles.size(), 0);
-        for (std::size_t f = 0; f < k.size(); ++f)
+        const Vec3& p = surface.Points[someVertex[c]];
+        for (int o = 0; o < n; ++o)
         {
-          k[f] = comp[f] == o;
-        }
-        TriangleMesh other = keepTriangles(surface, k);
-        if (windingNumber(other, surface.Points[someVertex[c]]) > 0.5)
-        {
-          keepComponent[c] = 0;
-          break;
+          if (o == c || volume[o] <= 0.0 || (p.array() < lo[o].array()).any() || (p.array() > hi[o].array()).any())
+          {
+            continue; // outside a closed component's box, its winding number is 0
+          }
+          if (windingOf(o, p) > 0.5)
+          {
+            keepComponent[c] = 0;
+            break;
+          }
         }
       }
-    }
+    });
   }
   removed = 0;
   for (int c = 0; c < n; ++c)
@@ -416,10 +442,6 @@ EnvelopeResult buildEnvelope(
   }
   const bool flood = result.SignUsed == SignMode::FloodFill;
   const bool useActivePoints = options.UseActivePoints && flood;
-  if (options.UseActivePoints && !flood)
-  {
-    result.SignReason += "; active points skipped (they need a closed input and the flood-fill rule)";
-  }
   // The input's tree for the verification is built meanwhile (on another thread when there is
   // one): the active points and the distance field come first. The winding-number rule needs
   // its dipoles too.

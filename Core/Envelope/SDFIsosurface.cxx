@@ -404,6 +404,12 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
     out.Cancelled = true;
     return out;
   }
+  if (unsignedField)
+  {
+    // OpenVDB's volumeToMesh inverts the polygons of grids not classed as level sets, and the
+    // unsigned distance is not; ours is read like one (inside = below the isovalue).
+    grid->setGridClass(openvdb::GRID_LEVEL_SET);
+  }
   if (sign == SignMode::WindingNumber && windingTree)
   {
     // Only voxels at or beyond the isovalue can change the isosurface by their sign (below it,
@@ -439,6 +445,108 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
       evaluated += e;
       inside += in;
     });
+    // The deep inside: beyond the band the grid holds only its background, read as outside.
+    // (a) The voxels of band leaves beyond the band take the winding number's side, by blocks of
+    // 2x2x2 voxels (w is smooth that far from the surface); inside ones become active -background.
+    const float background = grid->background();
+    using LeafT = openvdb::FloatTree::LeafNodeType;
+    std::vector<char> filledLeaf(leaves.leafCount(), 0);
+    auto leafIndex = [&](const openvdb::tree::LeafManager<openvdb::FloatTree>::LeafRange::Iterator& it) { return it.pos(); };
+    tbb::parallel_for(leaves.leafRange(), [&](const openvdb::tree::LeafManager<openvdb::FloatTree>::LeafRange& r) {
+      std::size_t e = 0;
+      for (auto leaf = r.begin(); leaf; ++leaf)
+      {
+        if (progressCancelled(progress))
+        {
+          return;
+        }
+        const openvdb::Coord origin = leaf->origin();
+        for (int bx = 0; bx < 8; bx += 2)
+          for (int by = 0; by < 8; by += 2)
+            for (int bz = 0; bz < 8; bz += 2)
+            {
+              openvdb::Index offsets[8];
+              int off = 0;
+              for (int i = 0; i < 2; ++i)
+                for (int j = 0; j < 2; ++j)
+                  for (int k = 0; k < 2; ++k)
+                  {
+                    const openvdb::Index o = LeafT::coordToOffset(origin.offsetBy(bx + i, by + j, bz + k));
+                    if (!leaf->isValueOn(o))
+                      offsets[off++] = o;
+                  }
+              if (off == 0)
+                continue;
+              const Vec3 x((origin.x() + bx + 0.5) * voxelSize, (origin.y() + by + 0.5) * voxelSize,
+                (origin.z() + bz + 0.5) * voxelSize);
+              ++e;
+              if (std::abs(windingTree->windingNumber(x)) > 0.5)
+              {
+                for (int q = 0; q < off; ++q)
+                  leaf->setValueOn(offsets[q], -background);
+                filledLeaf[leafIndex(leaf)] = 1;
+              }
+            }
+      }
+      evaluated += e;
+    });
+    // (b) Leaf-sized blocks of the input's box without band voxels: -background where inside.
+    {
+      Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+      for (const Vec3& p : unitMesh.Points)
+      {
+        lo = lo.cwiseMin(p);
+        hi = hi.cwiseMax(p);
+      }
+      const int b0[3] = { static_cast<int>(std::floor(lo.x() / voxelSize)) & ~7, static_cast<int>(std::floor(lo.y() / voxelSize)) & ~7,
+        static_cast<int>(std::floor(lo.z() / voxelSize)) & ~7 };
+      const int b1[3] = { static_cast<int>(std::ceil(hi.x() / voxelSize)), static_cast<int>(std::ceil(hi.y() / voxelSize)),
+        static_cast<int>(std::ceil(hi.z() / voxelSize)) };
+      std::vector<openvdb::Coord> blocks;
+      for (int x = b0[0]; x <= b1[0]; x += 8)
+        for (int y = b0[1]; y <= b1[1]; y += 8)
+          for (int z = b0[2]; z <= b1[2]; z += 8)
+            if (!grid->tree().probeConstLeaf(openvdb::Coord(x, y, z)))
+              blocks.emplace_back(x, y, z);
+      std::vector<char> insideBlock(blocks.size(), 0);
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks.size(), 256), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i)
+        {
+          const openvdb::Coord& c = blocks[i];
+          const Vec3 x((c.x() + 3.5) * voxelSize, (c.y() + 3.5) * voxelSize, (c.z() + 3.5) * voxelSize);
+          insideBlock[i] = std::abs(windingTree->windingNumber(x)) > 0.5;
+        }
+      });
+      evaluated += blocks.size();
+      // as leaves of active voxels, not as tiles: the extraction leaves cracks at tile borders and
+      // between inactive voxels
+      for (std::size_t i = 0; i < blocks.size(); ++i)
+      {
+        if (insideBlock[i])
+        {
+          grid->tree().touchLeaf(blocks[i])->fill(-background, true);
+        }
+      }
+      // a leaf with inside values next to a block without a leaf: that one gets an outside leaf, so
+      // that the crossing lies between two leaves (the extraction leaves cracks at a missing
+      // neighbour)
+      std::vector<openvdb::Coord> filled;
+      for (std::size_t i = 0; i < blocks.size(); ++i)
+        if (insideBlock[i])
+          filled.push_back(blocks[i]);
+      for (std::size_t i = 0; i < filledLeaf.size(); ++i)
+        if (filledLeaf[i])
+          filled.push_back(leaves.leaf(i).origin());
+      for (const openvdb::Coord& origin : filled)
+        for (int dx = -8; dx <= 8; dx += 8)
+          for (int dy = -8; dy <= 8; dy += 8)
+            for (int dz = -8; dz <= 8; dz += 8)
+            {
+              const openvdb::Coord n = origin.offsetBy(dx, dy, dz);
+              if (!grid->tree().probeConstLeaf(n))
+                grid->tree().touchLeaf(n)->fill(background, true);
+            }
+    }
     out.WindingEvaluations = evaluated.load();
     out.InsideVoxels = inside.load();
     out.WindingSeconds = seconds(tw);

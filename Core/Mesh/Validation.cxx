@@ -129,7 +129,7 @@ std::vector<std::string> MeshDefects::warnings() const
     w.push_back("the mesh is not a closed, consistently oriented 2-manifold (" + std::to_string(BoundaryEdges) +
       " boundary edges, " + std::to_string(NonManifoldEdges) + " non-manifold edges, " +
       std::to_string(NonManifoldVertices) + " non-manifold vertices, " + std::to_string(InconsistentEdges) +
-      " inconsistently oriented edges): its inside is taken from the generalized winding number");
+      " inconsistently oriented edges): it is caged all the same; SignMode says how its inside was decided");
   }
   if (IgnoredCells)
   {
@@ -231,7 +231,8 @@ bool triangulateEars(const std::vector<Vec3>& pts, const std::int64_t* ids, std:
   }
   std::vector<Triangle> tris;
   int remaining = static_cast<int>(n);
-  int i = 0;
+  int i = 1; // the first ear tried is (0, 1, 2): a quad gets the same split as a fan
+
   int sinceLastEar = 0;
   while (remaining > 3)
   {
@@ -265,10 +266,11 @@ bool triangulateEars(const std::vector<Vec3>& pts, const std::int64_t* ids, std:
   return true;
 }
 
-// Maps every referenced point to the first earlier referenced point within `tol` (per
-// coordinate), on a hashed grid of cells of size tol; returns the number of merged points.
-std::int64_t mergeCoincidentPoints(const std::vector<Vec3>& pts, const std::vector<char>& referenced, const Vec3& origin,
-  double tol, std::vector<std::int64_t>& representative)
+// Maps referenced points to the first earlier referenced point within `tol` (per coordinate),
+// where at least one of the two is on a boundary edge (two points inside closed surfaces are never
+// merged), on hashed grids of cells of size tol; returns the number of merged points.
+std::int64_t mergeCoincidentPoints(const std::vector<Vec3>& pts, const std::vector<char>& referenced,
+  const std::vector<char>& onBoundary, const Vec3& origin, double tol, std::vector<std::int64_t>& representative)
 {
   const std::size_t np = pts.size();
   representative.resize(np);
@@ -283,8 +285,23 @@ std::int64_t mergeCoincidentPoints(const std::vector<Vec3>& pts, const std::vect
     return (static_cast<std::uint64_t>(x) * 73856093ULL) ^ (static_cast<std::uint64_t>(y) * 19349663ULL) ^
       (static_cast<std::uint64_t>(z) * 83492791ULL);
   };
-  std::unordered_map<std::uint64_t, std::vector<std::int64_t>> grid;
-  grid.reserve(np);
+  using Grid = std::unordered_map<std::uint64_t, std::vector<std::int64_t>>;
+  Grid all, boundary; // representatives, and those of them on a boundary edge
+  all.reserve(np);
+  auto search = [&](const Grid& grid, const Vec3& p, std::int64_t cx, std::int64_t cy, std::int64_t cz) {
+    for (int dx = -1; dx <= 1; ++dx)
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dz = -1; dz <= 1; ++dz)
+        {
+          const auto it = grid.find(key(cx + dx, cy + dy, cz + dz));
+          if (it == grid.end())
+            continue;
+          for (std::int64_t j : it->second)
+            if ((pts[j] - p).cwiseAbs().maxCoeff() <= tol)
+              return j;
+        }
+    return std::int64_t(-1);
+  };
   std::int64_t merged = 0;
   for (std::size_t i = 0; i < np; ++i)
   {
@@ -295,32 +312,17 @@ std::int64_t mergeCoincidentPoints(const std::vector<Vec3>& pts, const std::vect
     const Vec3& p = pts[i];
     const Vec3 rel = p - origin;
     const std::int64_t cx = cell(rel.x()), cy = cell(rel.y()), cz = cell(rel.z());
-    std::int64_t found = -1;
-    const int reach = 1;
-    for (int dx = -reach; dx <= reach && found < 0; ++dx)
-      for (int dy = -reach; dy <= reach && found < 0; ++dy)
-        for (int dz = -reach; dz <= reach && found < 0; ++dz)
-        {
-          const auto it = grid.find(key(cx + dx, cy + dy, cz + dz));
-          if (it == grid.end())
-            continue;
-          for (std::int64_t j : it->second)
-          {
-            if ((pts[j] - p).cwiseAbs().maxCoeff() <= tol)
-            {
-              found = j;
-              break;
-            }
-          }
-        }
+    const std::int64_t found = search(onBoundary[i] ? all : boundary, p, cx, cy, cz);
     if (found >= 0)
     {
       representative[i] = found;
       ++merged;
+      continue;
     }
-    else
+    all[key(cx, cy, cz)].push_back(static_cast<std::int64_t>(i));
+    if (onBoundary[i])
     {
-      grid[key(cx, cy, cz)].push_back(static_cast<std::int64_t>(i));
+      boundary[key(cx, cy, cz)].push_back(static_cast<std::int64_t>(i));
     }
   }
   return merged;
@@ -530,11 +532,64 @@ MeshDefects prepareMesh(const PolygonMesh& input, TriangleMesh& output, const Va
     return d; // geometry cannot be trusted further
   }
 
-  // 2. coincident points merged (split seams, STL facet corners, duplicated scan points)
+  // 2. coincident points merged (split seams, STL facet corners, duplicated scan points) where
+  // one of them is on a boundary edge of the cells as given: a split seam is closed again, while
+  // two distinct points of a closed surface that happen to coincide stay apart (merging them
+  // would make a non-manifold vertex). A mesh without boundary edges or zero-area triangles skips
+  // this.
   std::vector<std::int64_t> rep;
   const double diagonal = (hi - lo).allFinite() ? (hi - lo).norm() : 0.0;
   d.MergeTolerance = options.MergeTolerance >= 0.0 ? options.MergeTolerance * diagonal : -1.0;
-  d.MergedPoints = mergeCoincidentPoints(input.Points, referenced, lo, d.MergeTolerance, rep);
+  {
+    std::vector<std::uint64_t> edges;
+    edges.reserve(input.Connectivity.size());
+    for (std::size_t c = 0; c < nc; ++c)
+    {
+      if (!cellValid[c])
+        continue;
+      const std::int64_t b = input.Offsets[c], e = input.Offsets[c + 1];
+      for (std::int64_t k = b; k < e; ++k)
+      {
+        const std::uint64_t u = static_cast<std::uint64_t>(input.Connectivity[k]);
+        const std::uint64_t v = static_cast<std::uint64_t>(input.Connectivity[k + 1 < e ? k + 1 : b]);
+        if (u != v)
+          edges.push_back(std::min(u, v) << 32 | std::max(u, v));
+      }
+    }
+    std::sort(edges.begin(), edges.end());
+    std::vector<char> onBoundary(np, 0);
+    bool any = false;
+    // the corners of zero-area triangles count too: a sliver between two coincident points hides
+    // the seam it closes (dragon_vrip.ply has such)
+    for (std::size_t c = 0; c < nc; ++c)
+    {
+      const std::int64_t b = input.Offsets[c];
+      if (!cellValid[c] || input.Offsets[c + 1] - b != 3)
+        continue;
+      const Vec3& p0 = input.Points[input.Connectivity[b]];
+      const Vec3& p1 = input.Points[input.Connectivity[b + 1]];
+      const Vec3& p2 = input.Points[input.Connectivity[b + 2]];
+      if ((p1 - p0).cross(p2 - p0).squaredNorm() == 0.0)
+      {
+        for (int k = 0; k < 3; ++k)
+          onBoundary[input.Connectivity[b + k]] = 1;
+        any = true;
+      }
+    }
+    for (std::size_t i = 0; i < edges.size();)
+    {
+      std::size_t j = i;
+      while (j < edges.size() && edges[j] == edges[i])
+        ++j;
+      if (j - i == 1)
+      {
+        onBoundary[edges[i] >> 32] = onBoundary[edges[i] & 0xffffffffULL] = 1;
+        any = true;
+      }
+      i = j;
+    }
+    d.MergedPoints = mergeCoincidentPoints(input.Points, referenced, onBoundary, lo, any ? d.MergeTolerance : -1.0, rep);
+  }
   auto id = [&](std::int64_t k) { return static_cast<int>(rep[input.Connectivity[k]]); };
 
   // 3. cells -> triangles: convex planar polygons by a fan (as before), others by ear clipping

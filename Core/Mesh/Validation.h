@@ -65,10 +65,11 @@ struct ValidationOptions
   /// Relative area threshold (to the squared bounding-box diagonal) under which a triangle counts
   /// as degenerate. 0 means exactly zero area only.
   double DegenerateAreaTolerance = 0.0;
-  /// Points closer than this (relative to the bounding-box diagonal, per coordinate) are merged:
-  /// far below any voxel size (1e-9 against 0.005 of the unit sphere), it only joins positions
-  /// that are the same up to rounding, such as the split seams of a textured OBJ, an STL's
-  /// separate facet corners or a scan's duplicated points. Negative: no merging.
+  /// Points closer than this, at least one of them on a boundary edge, (relative to the bounding-box diagonal, per
+  /// coordinate) are merged: far below any voxel size (1e-9 against 0.005 of the unit sphere), it
+  /// only joins positions that are the same up to rounding, such as the split seams of a textured
+  /// OBJ, an STL's separate facet corners or a scan's duplicated points. Points inside a closed
+  /// surface are never merged (that would make non-manifold vertices). Negative: no merging.
   double MergeTolerance = 1e-9;
 };
 

@@ -1126,10 +1126,10 @@ OptimizeResult optimizeCageInInputUnits(const TriangleMesh& cage, const Triangle
   r.Cage = cage;
   TriangleMesh in, cg;
   const MeshDefects di = prepareMesh(PolygonMesh::fromTriangles(input), in);
-  if (!di.usable())
+  if (!di.usableAsInput()) // any surface (open, soup) can be the input; the cage must be closed
   {
-    r.State = di.Empty ? Status::EmptyInput : Status::InvalidInput;
-    r.Message = "input mesh: " + (di.Empty ? std::string("it has no triangles") : di.errorMessage());
+    r.State = di.Empty && di.NonFinitePoints == 0 && di.InvalidPointIds == 0 ? Status::EmptyInput : Status::InvalidInput;
+    r.Message = "input mesh: " + di.inputErrorMessage();
     return r;
   }
   const MeshDefects dc = prepareMesh(PolygonMesh::fromTriangles(cage), cg);

@@ -212,7 +212,11 @@ void printSummary(std::ostream& os, const RunReport& r)
       os << ", genus " << count("InputGenus");
     os << "\n";
   }
-  if (r.UseActivePoints)
+  if (r.UseActivePoints && text("SignMode") != "flood" && !text("SignMode").empty())
+  {
+    os << "active pts  : skipped (they need a closed input and the flood-fill rule)\n";
+  }
+  else if (r.UseActivePoints)
   {
     os << "active pts  : " << r.NumberOfActivePoints << " input points (r " << number(r.ActiveRadius)
        << ", l " << number(r.GeodesicThreshold) << ", alpha " << number(r.AmplificationAlpha)

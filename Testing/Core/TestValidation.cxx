@@ -152,21 +152,22 @@ TEST(Validation, QuadsAreTriangulated)
   EXPECT_FALSE(d.warnings().empty()); // the split is reported
 }
 
-TEST(Validation, NonPlanarPolygonIsNotSplit)
+TEST(Validation, NonPlanarPolygonIsSplit)
 {
   // Raise one corner of the top face: the top quad is no longer planar (the side quads through
-  // that corner stay planar), so how to split it is a choice the input does not determine.
+  // that corner stay planar). It is split by ear clipping in its best-fit plane, as VTK's
+  // triangle filter would, and reported.
   PolygonMesh m = quadCube();
   m.Points[7][2] = 1.3;
   TriangleMesh out;
   const MeshDefects d = prepareMesh(m, out);
-  EXPECT_EQ(d.UntriangulatedPolygons, 1);
-  EXPECT_EQ(d.TriangulatedPolygons, 5);
-  EXPECT_FALSE(d.usable());
-  EXPECT_FALSE(d.errorMessage().empty());
+  EXPECT_EQ(d.UntriangulatedPolygons, 0);
+  EXPECT_EQ(d.TriangulatedPolygons, 6);
+  EXPECT_EQ(out.Triangles.size(), 12u);
+  EXPECT_TRUE(d.usable()) << d.errorMessage();
 }
 
-TEST(Validation, NonConvexPolygonIsNotSplit)
+TEST(Validation, NonConvexPolygonIsSplitByEars)
 {
   // An L-shaped prism: top and bottom are planar, non-convex hexagons.
   PolygonMesh m;
@@ -187,9 +188,11 @@ TEST(Validation, NonConvexPolygonIsNotSplit)
   }
   TriangleMesh out;
   const MeshDefects d = prepareMesh(m, out);
-  EXPECT_EQ(d.UntriangulatedPolygons, 2);
-  EXPECT_EQ(d.TriangulatedPolygons, 6);
-  EXPECT_FALSE(d.usable());
+  EXPECT_EQ(d.UntriangulatedPolygons, 0);
+  EXPECT_EQ(d.TriangulatedPolygons, 8);
+  EXPECT_TRUE(d.usable()) << d.errorMessage();
+  EXPECT_EQ(out.Triangles.size(), 2u * 4u + 6u * 2u); // each hexagon in 4 ears, each quad in 2
+  EXPECT_NEAR(signedVolume(out), 3.0, 1e-12);          // the L (area 3) times height 1: no overlap
 }
 
 TEST(Validation, BoundaryEdgesOfAnOpenBox)
@@ -275,12 +278,16 @@ TEST(Validation, DegenerateTriangle)
   box.Triangles.push_back({ a, b, mid });
   TriangleMesh out;
   const MeshDefects d = prepareMesh(PolygonMesh::fromTriangles(box), out);
-  EXPECT_EQ(d.DegenerateTriangles, 1);
-  EXPECT_EQ(d.BoundaryEdges, 0);
+  // dropped and counted; the zero-width crack it closed is left as 3 boundary edges
+  EXPECT_EQ(d.DroppedDegenerateTriangles, 1);
+  EXPECT_EQ(d.DegenerateTriangles, 0);
+  EXPECT_EQ(d.BoundaryEdges, 3);
   EXPECT_EQ(d.NonManifoldEdges, 0);
   EXPECT_EQ(d.InconsistentEdges, 0);
   EXPECT_FALSE(d.usable());
-  EXPECT_FALSE(d.errorMessage().empty());
+  EXPECT_TRUE(d.usableAsInput());
+  EXPECT_EQ(out.Triangles.size(), 13u);
+  EXPECT_FALSE(d.warnings().empty());
 
   // Repeated ids are degenerate too.
   TriangleMesh repeated = makeBox(Vec3(0, 0, 0), Vec3(1, 1, 1));
@@ -325,7 +332,7 @@ TEST(Validation, DegenerateAreaTolerance)
   EXPECT_TRUE(strict.usable()) << strict.errorMessage();
   ValidationOptions tolerant;
   tolerant.DegenerateAreaTolerance = 1e-6;
-  EXPECT_EQ(prepareMesh(PolygonMesh::fromTriangles(sliver), out, tolerant).DegenerateTriangles, 1);
+  EXPECT_EQ(prepareMesh(PolygonMesh::fromTriangles(sliver), out, tolerant).DroppedDegenerateTriangles, 1);
 }
 
 TEST(Validation, InconsistentOrientation)

@@ -97,32 +97,52 @@ for name in ("ActiveRadius", "GeodesicThreshold", "AmplificationAlpha", "Amplifi
           "SDF Cage and Active Points share the default %s" % name)
 Delete(fresh)
 
-# --- an open input: error, empty output, no crash ----------------------------------------------
+# --- an open input (a sheet): a cage around it, the inside rule in the field data ---------------
 plane = Plane(XResolution=4, YResolution=4)  # an open sheet: 16 boundary edges
-bad = SDFCage(Input=plane)
-# Capture the expected error (and the executive's "returned failure") with observers on the
-# server-side objects (builtin session), so that nothing reaches the output window.
-captured = []
+sheet_cage = SDFCage(Input=plane, TargetNumberOfVertices=60)
+check(sheet_cage.SignMode == "Auto", "SignMode default Auto (got %s)" % sheet_cage.SignMode)
+sheet_cage.UpdatePipeline()
+sheet_out = servermanager.Fetch(sheet_cage)
+check(sheet_out.GetNumberOfPoints() == 60, "open sheet: a 60-vertex cage (got %d)" % sheet_out.GetNumberOfPoints())
+sheet_cage.UpdatePropertyInformation()
+check(sheet_cage.GetProperty("StatusInfo").GetElement(0) == "Ok", "open sheet: Ok")
+sign = sheet_out.GetFieldData().GetAbstractArray("SignMode")
+check(sign is not None and sign.GetValue(0) == "winding", "open sheet: SignMode winding in the field data")
+edges = sheet_out.GetFieldData().GetArray("InputBoundaryEdges")
+check(edges is not None and edges.GetValue(0) == 16, "open sheet: 16 boundary edges reported")
 
-
-def on_error(caller, event, calldata=None):
-    captured.append(str(calldata))
-
-
-from vtkmodules.vtkCommonCore import VTK_STRING  # noqa: E402
-on_error.CallDataType = VTK_STRING  # pass the message to the observer
-bad_object = bad.GetClientSideObject()
-bad_object.AddObserver("ErrorEvent", on_error)
-bad_object.GetExecutive().AddObserver("ErrorEvent", on_error)
-bad.UpdatePipeline()
-check(any("boundary" in m for m in captured), "open input: an error event names boundary edges")
-bad_out = servermanager.Fetch(bad)
-check(bad_out.GetNumberOfPoints() == 0, "open input gives an empty cage")
-bad.UpdatePropertyInformation()
-check(bad.GetProperty("StatusInfo").GetElement(0) == "InvalidInput", "open input: InvalidInput")
-message = bad.GetProperty("LastErrorMessageInfo").GetElement(0)
-print("error message:", message)
-check("boundary" in message, "open input: the message names boundary edges")
+# --- ParaView's own OBJ reader on a closed, textured OBJ: the seams come in split -----------------
+# Every face corner has its own texture coordinate, so the reader makes a separate point for each
+# corner (a closed sphere arrives as a soup of triangles); the filter merges them back.
+src = servermanager.Fetch(Sphere(Radius=1.0, ThetaResolution=16, PhiResolution=12))
+obj_path = os.path.join(scratch, "textured_sphere.obj")
+with open(obj_path, "w") as obj:
+    for i in range(src.GetNumberOfPoints()):
+        obj.write("v %.17g %.17g %.17g\n" % src.GetPoint(i))
+    corner = 0
+    faces = []
+    for c in range(src.GetNumberOfCells()):
+        ids = src.GetCell(c).GetPointIds()
+        f = []
+        for k in range(ids.GetNumberOfIds()):
+            corner += 1
+            obj.write("vt %.6f %.6f\n" % ((corner % 97) / 97.0, (corner % 89) / 89.0))
+            f.append("%d/%d" % (ids.GetId(k) + 1, corner))
+        faces.append("f " + " ".join(f) + "\n")
+    obj.writelines(faces)
+reader = OpenDataFile(obj_path)
+read = servermanager.Fetch(reader)
+check(read.GetNumberOfPoints() > src.GetNumberOfPoints(),
+      "ParaView's OBJ reader splits the seams (%d points for %d)" % (read.GetNumberOfPoints(), src.GetNumberOfPoints()))
+obj_cage = SDFCage(Input=reader, TargetNumberOfVertices=100)
+obj_cage.UpdatePipeline()
+obj_out = servermanager.Fetch(obj_cage)
+fd = obj_out.GetFieldData()
+check(obj_out.GetNumberOfPoints() == 100, "textured OBJ: a 100-vertex cage (got %d)" % obj_out.GetNumberOfPoints())
+check(fd.GetArray("EnclosureVerified").GetValue(0) == 1, "textured OBJ: enclosure verified")
+check(fd.GetArray("MergedPoints").GetValue(0) == read.GetNumberOfPoints() - src.GetNumberOfPoints(),
+      "textured OBJ: the split points are merged back (%g)" % fd.GetArray("MergedPoints").GetValue(0))
+check(fd.GetAbstractArray("SignMode").GetValue(0) == "flood", "textured OBJ: closed again, so the flood-fill path")
 
 # --- the Cage Optimize filter (two inputs: the cage and the source mesh) ------------------------
 check("CageOptimize" in globals() or "CageOptimizeFilter" in globals(), "the plugin defines CageOptimize()")
