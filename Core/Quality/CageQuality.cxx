@@ -1,5 +1,7 @@
 #include "Quality/CageQuality.h"
 
+#include "Quality/Verification.h"
+
 #include "Envelope/Envelope.h"
 #include "Spatial/Geometry.h"
 #include "Common/Progress.h"
@@ -85,46 +87,6 @@ std::vector<double> pointDistances(const TriangleMesh& mesh, const std::vector<c
     }
   });
   return d;
-}
-
-/// Pairs of cage triangles that conflict (Geometry.h trianglesConflict): sharing no vertex and
-/// closer than `touching` (or crossing), sharing one vertex and meeting elsewhere, sharing an
-/// edge and folded exactly onto each other, or repeating the same three vertices. The same test
-/// as Envelope's countSelfIntersections, with this judge's touching tolerance.
-long long countSelfIntersectingPairs(const TriangleMesh& mesh, double touching, Progress* progress)
-{
-  TriangleIndex index;
-  index.build(mesh);
-  const double foldCosine = -1.0 + 1e-12; // exactly opposite normals only
-  const Vec3 pad = Vec3::Constant(touching);
-  return tbb::parallel_reduce(
-    tbb::blocked_range<std::size_t>(0, mesh.Triangles.size(), 256), 0LL,
-    [&](const tbb::blocked_range<std::size_t>& r, long long count) {
-      if (progressCancelled(progress))
-      {
-        return count;
-      }
-      for (std::size_t f = r.begin(); f != r.end(); ++f)
-      {
-        const Triangle& t = mesh.Triangles[f];
-        const int ia[3] = { t[0], t[1], t[2] };
-        const Vec3 pa[3] = { mesh.Points[t[0]], mesh.Points[t[1]], mesh.Points[t[2]] };
-        const Vec3 lo = pa[0].cwiseMin(pa[1]).cwiseMin(pa[2]) - pad;
-        const Vec3 hi = pa[0].cwiseMax(pa[1]).cwiseMax(pa[2]) + pad;
-        index.forEachTriangleInBox(lo, hi, [&](int g) {
-          if (static_cast<std::size_t>(g) <= f)
-          {
-            return;
-          }
-          const Triangle& o = mesh.Triangles[g];
-          const int ib[3] = { o[0], o[1], o[2] };
-          const Vec3 pb[3] = { mesh.Points[o[0]], mesh.Points[o[1]], mesh.Points[o[2]] };
-          count += trianglesConflict(ia, pa, ib, pb, touching, foldCosine) ? 1 : 0;
-        });
-      }
-      return count;
-    },
-    [](long long a, long long b) { return a + b; });
 }
 
 struct UnionFind
@@ -581,7 +543,7 @@ CageQualityResult evaluateCage(const TriangleMesh& inputMesh, const TriangleMesh
   progressStage(progress, "self-intersections", 0.1, 0.2);
   if (!cage.empty())
   {
-    r.SelfIntersections = countSelfIntersectingPairs(cage, touching, progress) + r.DegenerateTriangles;
+    r.SelfIntersections = countSelfIntersections(cage, progress, touching) + r.DegenerateTriangles;
     if (r.SelfIntersections > 0)
     {
       reasons.push_back("the cage intersects itself (" + std::to_string(r.SelfIntersections) + " triangle pairs)");

@@ -19,18 +19,21 @@
 namespace sdfcage
 {
 
-long long countSelfIntersections(const TriangleMesh& mesh, Progress* progress)
+long long countSelfIntersections(const TriangleMesh& mesh, Progress* progress, double touching)
 {
   TriangleIndex index;
   index.build(mesh);
-  const std::size_t nf = mesh.Triangles.size();
   // exact-intersection fold test for edge-sharing pairs: only exactly opposite normals overlap
   const double foldCosine = -1.0 + 1e-12;
-  // disjoint triangles closer than this (relative to the mesh size) count as touching
-  const auto box = bounds(mesh);
-  const double touching = 1e-12 * std::max(1.0, (box[1] - box[0]).norm());
+  if (!(touching >= 0.0))
+  {
+    // disjoint triangles closer than this (relative to the mesh size) count as touching
+    const auto box = bounds(mesh);
+    touching = 1e-12 * std::max(1.0, (box[1] - box[0]).norm());
+  }
+  const Vec3 pad = Vec3::Constant(touching);
   return tbb::parallel_reduce(
-    tbb::blocked_range<std::size_t>(0, nf, 2048), 0LL,
+    tbb::blocked_range<std::size_t>(0, mesh.Triangles.size(), 256), 0LL,
     [&](const tbb::blocked_range<std::size_t>& r, long long count) {
       if (progressCancelled(progress))
       {
@@ -41,8 +44,8 @@ long long countSelfIntersections(const TriangleMesh& mesh, Progress* progress)
         const Triangle& t = mesh.Triangles[f];
         const int ia[3] = { t[0], t[1], t[2] };
         const Vec3 pa[3] = { mesh.Points[t[0]], mesh.Points[t[1]], mesh.Points[t[2]] };
-        const Vec3 lo = pa[0].cwiseMin(pa[1]).cwiseMin(pa[2]);
-        const Vec3 hi = pa[0].cwiseMax(pa[1]).cwiseMax(pa[2]);
+        const Vec3 lo = pa[0].cwiseMin(pa[1]).cwiseMin(pa[2]) - pad;
+        const Vec3 hi = pa[0].cwiseMax(pa[1]).cwiseMax(pa[2]) + pad;
         index.forEachTriangleInBox(lo, hi, [&](int g) {
           if (static_cast<std::size_t>(g) <= f)
           {
@@ -51,7 +54,7 @@ long long countSelfIntersections(const TriangleMesh& mesh, Progress* progress)
           const Triangle& o = mesh.Triangles[g];
           const int ib[3] = { o[0], o[1], o[2] };
           const Vec3 pb[3] = { mesh.Points[o[0]], mesh.Points[o[1]], mesh.Points[o[2]] };
-          count += trianglesConflict(ia, pa, ib, pb, touching, foldCosine);
+          count += trianglesConflict(ia, pa, ib, pb, touching, foldCosine) ? 1 : 0;
         });
       }
       return count;

@@ -14,8 +14,12 @@ namespace sdfcage
 class Progress;
 class TriangleTree;
 
-/// Pairs of triangles of `mesh` that intersect (beyond shared vertices/edges). Threaded.
-long long countSelfIntersections(const TriangleMesh& mesh, Progress* progress = nullptr);
+/// Pairs of triangles of `mesh` that conflict (Spatial/Geometry.h trianglesConflict): sharing no
+/// vertex and closer than `touching` (or crossing), sharing one vertex and meeting elsewhere,
+/// sharing an edge and folded exactly onto each other, or repeating the same three vertices.
+/// `touching` < 0: 1e-12 of the mesh size. Threaded. The one count of the envelope and cage
+/// checks and of the quality judge (Quality/CageQuality.h).
+long long countSelfIntersections(const TriangleMesh& mesh, Progress* progress = nullptr, double touching = -1.0);
 
 /// Independent check used by buildEnvelope and by tests: closed 2-manifold without
 /// self-intersections, every triangle of
