@@ -74,6 +74,24 @@ int triangleComponents(const TriangleMesh& mesh, std::vector<int>& componentOfTr
   return count;
 }
 
+std::vector<Vec3> componentProbes(const TriangleMesh& mesh)
+{
+  std::vector<int> comp;
+  const int n = triangleComponents(mesh, comp);
+  std::vector<Vec3> probes;
+  probes.reserve(n);
+  std::vector<char> seen(n, 0);
+  for (std::size_t f = 0; f < mesh.Triangles.size(); ++f)
+  {
+    if (!seen[comp[f]])
+    {
+      seen[comp[f]] = 1;
+      probes.push_back(mesh.Points[mesh.Triangles[f][0]]);
+    }
+  }
+  return probes;
+}
+
 namespace
 {
 std::vector<std::uint64_t> uniqueEdgeKeys(const TriangleMesh& mesh, const std::vector<int>* subset)

@@ -51,6 +51,11 @@ double signedVolume(const TriangleMesh& mesh);
 /// number of components.
 int triangleComponents(const TriangleMesh& mesh, std::vector<int>& componentOfTriangle);
 
+/// One input point per connected component (the first corner of its first triangle): a surface
+/// that keeps away from the input has each component wholly inside or wholly outside, so these
+/// points decide enclosure (verification) and must never be swept across (simplification).
+std::vector<Vec3> componentProbes(const TriangleMesh& mesh);
+
 /// Euler characteristic V - E + F counted over referenced vertices and unique undirected edges.
 long long eulerCharacteristic(const TriangleMesh& mesh);
 

@@ -921,6 +921,24 @@ public:
       if (Tree.anyCloserThan(p, Delta))
         return -1;
     }
+    // the flip sweeps the tetrahedron (a, b, c, d): an input component wholly inside it (its
+    // representative inside; none comes near the four faces) would end up outside the cage
+    {
+      const Vec3 lo = P[a].cwiseMin(P[b]).cwiseMin(P[c]).cwiseMin(P[d]);
+      const Vec3 hi = P[a].cwiseMax(P[b]).cwiseMax(P[c]).cwiseMax(P[d]);
+      const Vec3 t[4] = { P[a], P[b], P[c], P[d] };
+      for (const Vec3& x : Representatives)
+      {
+        if ((x.array() < lo.array()).any() || (x.array() > hi.array()).any())
+          continue;
+        const double s0 = (t[1] - x).dot((t[2] - x).cross(t[3] - x));
+        const double s1 = (t[0] - x).dot((t[3] - x).cross(t[2] - x));
+        const double s2 = (t[0] - x).dot((t[1] - x).cross(t[3] - x));
+        const double s3 = (t[0] - x).dot((t[2] - x).cross(t[1] - x));
+        if ((s0 >= 0 && s1 >= 0 && s2 >= 0 && s3 >= 0) || (s0 <= 0 && s1 <= 0 && s2 <= 0 && s3 <= 0))
+          return -1;
+      }
+    }
     if (trianglesConflict(ids1, p1, ids2, p2, SelfDelta, FoldCosine))
       return -1;
     const int skip[2] = { f1, f2 };

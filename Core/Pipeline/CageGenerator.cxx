@@ -31,9 +31,12 @@ ScalarImage imageToInput(ScalarImage image, const Normalization& n)
   return image;
 }
 
-CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Progress* progress)
+namespace
+{
+CageResult generateOnce(const PolygonMesh& input, const CageOptions& options, Progress* progress)
 {
   CageResult result;
+  result.IsoValueUsed = options.Envelope.IsoValue;
   const auto start = std::chrono::steady_clock::now();
   std::unique_ptr<tbb::global_control> threads;
   if (options.Envelope.NumberOfThreads > 0)
@@ -131,7 +134,8 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
     so.TargetVertices = options.TargetNumberOfVertices;
     so.Clearance = options.Envelope.clearance();
     progressStage(progress, "simplifying", 0.45, 0.95);
-    result.Simplification = simplifyEnvelope(env.Envelope, tree, so, progress);
+    const std::vector<Vec3> probes = componentProbes(unit);
+    result.Simplification = simplifyEnvelope(env.Envelope, tree, so, progress, &probes);
     result.SimplificationSeconds = result.Simplification.Seconds;
     result.VerticesReached = result.Simplification.VerticesReached;
     result.TargetReached = result.Simplification.ReachedTarget;
@@ -192,6 +196,47 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
   result.TotalSeconds = seconds(start);
   progressUpdate(progress, 1.0);
   return result;
+}
+
+/// Should the envelope be widened (see CageOptions::MaximumEnvelopeWidenings)?
+bool wantsWidening(const CageResult& r, const CageOptions& options, int done, Progress* progress)
+{
+  return done < options.MaximumEnvelopeWidenings && options.TargetNumberOfVertices > 0 &&
+    r.State == Status::Ok && !r.TargetReached && !r.InputClosed && !progressCancelled(progress);
+}
+} // namespace
+
+CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Progress* progress)
+{
+  const auto start = std::chrono::steady_clock::now();
+  CageResult best = generateOnce(input, options, progress);
+  CageOptions wider = options;
+  int tried = 0;
+  for (int k = 0; wantsWidening(best, options, k, progress); ++k)
+  {
+    tried = k + 1;
+    wider.Envelope.IsoValue *= 2.0;
+    progressStage(progress, "widening the envelope to reach the target", 0.0, 1.0);
+    CageResult next = generateOnce(input, wider, progress);
+    // keep the cage that reaches the target, or the one closest to it (ties: the tighter one)
+    if (next.State == Status::Ok && next.VerticesReached < best.VerticesReached)
+    {
+      next.EnvelopeWidenings = k + 1;
+      next.StopReason = next.TargetReached ? std::string() : next.StopReason;
+      best = std::move(next);
+    }
+    else if (next.State == Status::Cancelled)
+    {
+      break;
+    }
+  }
+  if (tried > 0 && !best.TargetReached && best.State == Status::Ok)
+  {
+    best.StopReason += "; envelopes widened up to isovalue " + std::to_string(wider.Envelope.IsoValue) +
+      " did not get closer to the target";
+  }
+  best.TotalSeconds = seconds(start);
+  return best;
 }
 
 } // namespace sdfcage

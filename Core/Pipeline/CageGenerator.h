@@ -22,6 +22,16 @@ struct CageOptions
   /// taken from Envelope.clearance(). Not applied when TargetNumberOfVertices is 0.
   bool Optimize = false;
   OptimizeOptions Optimization;
+  /// Inputs without a defined topology (open, soups, non-manifold: not a closed, consistently
+  /// oriented 2-manifold) have no genus to keep, and their envelope can have more parts and
+  /// handles than the target's vertices can carry (debris beside a body, gaps between the parts
+  /// of a model). When the target is not reached for such an input, the envelope is built again
+  /// with twice the isovalue (the automatic voxel size and clearance follow it), which fuses
+  /// parts and closes handles narrower than about twice the new isovalue, up to this many
+  /// times; the cage that reaches the target (or gets closest) is kept and IsoValueUsed /
+  /// EnvelopeWidenings say what was done. Closed inputs are never widened (their topology is
+  /// kept). 0 = off.
+  int MaximumEnvelopeWidenings = 2;
 };
 
 struct CageResult
@@ -67,6 +77,8 @@ struct CageResult
   bool Optimized = false;           ///< the optimization ran and its result is the cage
   double OptimizationSeconds = 0.0;
   double TotalSeconds = 0.0;
+  double IsoValueUsed = 0.0;        ///< unit-sphere units: the requested one, or widened (see MaximumEnvelopeWidenings)
+  int EnvelopeWidenings = 0;        ///< envelopes rebuilt with twice the isovalue to reach the target
   ScalarImage DistanceField;        ///< input coordinates and units, when requested
   ScalarImage ModifiedDistanceField; ///< phi * xi, input units, when requested and active points exist
   Normalization Normalize;

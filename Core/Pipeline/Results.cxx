@@ -53,6 +53,8 @@ std::vector<ResultField> inputResults(const CageResult& r)
     text("SignMode", signModeName(r.SignUsed), "the inside rule used: flood, winding or unsigned"),
     text("SignReason", r.SignReason, "why that rule"),
     real("WindingTime", r.WindingSeconds, "s", "winding-number sign (part of DistanceFieldTime)"),
+    real("IsoValueUsed", r.IsoValueUsed, "relative", "isovalue of the envelope the cage comes from (unit-sphere units)"),
+    integer("EnvelopeWidenings", r.EnvelopeWidenings, "count", "envelopes rebuilt with twice the isovalue to reach the target (inputs without a defined topology only)"),
   };
 }
 

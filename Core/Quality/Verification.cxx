@@ -210,23 +210,15 @@ bool verifyEnclosure(const TriangleMesh& input, const TriangleMesh& cage, double
 
   // 3. enclosure: the surface never comes near the input, so each input component lies entirely
   // inside or entirely outside; test one vertex per component by winding number.
-  std::vector<int> comp;
-  const int ncomp = triangleComponents(input, comp);
-  std::vector<int> probe(ncomp, -1);
-  for (std::size_t f = 0; f < input.Triangles.size(); ++f)
-  {
-    if (probe[comp[f]] < 0)
-    {
-      probe[comp[f]] = input.Triangles[f][0];
-    }
-  }
+  const std::vector<Vec3> probe = componentProbes(input);
+  const int ncomp = static_cast<int>(probe.size());
   // one probe per component, in parallel (soups have many components)
   const int outside = tbb::parallel_reduce(
     tbb::blocked_range<int>(0, ncomp, 1), 0,
     [&](const tbb::blocked_range<int>& r, int count) {
       for (int c = r.begin(); c != r.end(); ++c)
       {
-        count += windingNumber(cage, input.Points[probe[c]]) < 0.5;
+        count += windingNumber(cage, probe[c]) < 0.5;
       }
       return count;
     },

@@ -244,7 +244,8 @@ struct Eval
 class Simplifier
 {
 public:
-  Simplifier(const TriangleMesh& mesh, const TriangleTree& input, const SimplifyOptions& o, Progress* p)
+  Simplifier(const TriangleMesh& mesh, const TriangleTree& input, const SimplifyOptions& o, Progress* p,
+    const std::vector<Vec3>* probes)
     : Input(input)
     , Opt(o)
     , Original(o)
@@ -278,6 +279,11 @@ public:
         Q[v] += q;
     }
     rebuildGrid();
+    if (probes)
+    {
+      Probes = *probes;
+      std::sort(Probes.begin(), Probes.end(), [](const Vec3& a, const Vec3& b) { return a.x() < b.x(); });
+    }
   }
 
   SimplifyResult run()
@@ -827,6 +833,8 @@ private:
         if (Input.anyCloserThan(nt.Pts, delta))
           return Verdict::Input;
       }
+      if (sweepsProbe(p, ev))
+        return Verdict::Input;
     }
     if (!Opt.EnforceNoSelfIntersection)
       return Verdict::Ok;
@@ -916,6 +924,57 @@ private:
       }
     }
     return Verdict::Ok;
+  }
+
+  // Would the collapse sweep an input component out of the cage? The old one-ring (the changed
+  // and removed triangles) and the new one (the changed triangles with v1 -> v0 at p) share
+  // their boundary, so together (the new one reversed) they close the region the collapse sweeps
+  // over; the cage's winding number changes by exactly that region's winding number there. The
+  // clearance keeps every input component away from both rings, so a component is wholly in
+  // the region or wholly out of it, and one probe point per component decides. Without this, a
+  // component smaller than the cage's triangles (a fragment of a soup) can be jumped over
+  // without any new triangle coming near it.
+  bool sweepsProbe(const Vec3& p, const Eval& ev) const
+  {
+    if (Probes.empty())
+      return false;
+    Vec3 lo = p, hi = p;
+    auto grow = [&](int f) {
+      for (int v : T[f])
+      {
+        lo = lo.cwiseMin(P[v]);
+        hi = hi.cwiseMax(P[v]);
+      }
+    };
+    for (int f : ev.Changed)
+      grow(f);
+    for (int f : ev.Removed)
+      grow(f);
+    auto first = std::lower_bound(Probes.begin(), Probes.end(), lo.x(), [](const Vec3& a, double x) { return a.x() < x; });
+    for (auto it = first; it != Probes.end() && it->x() <= hi.x(); ++it)
+    {
+      const Vec3& x = *it;
+      if (x.y() < lo.y() || x.y() > hi.y() || x.z() < lo.z() || x.z() > hi.z())
+        continue;
+      double angle = 0.0;
+      for (int f : ev.Changed)
+      {
+        const Triangle& t = T[f];
+        angle += solidAngle(x, P[t[0]], P[t[1]], P[t[2]]);
+        int ids[3];
+        Vec3 pts[3];
+        newTriangle(ev, f, p, ids, pts);
+        angle -= solidAngle(x, pts[0], pts[1], pts[2]);
+      }
+      for (int f : ev.Removed)
+      {
+        const Triangle& t = T[f];
+        angle += solidAngle(x, P[t[0]], P[t[1]], P[t[2]]);
+      }
+      if (std::abs(angle) > 2.0 * M_PI) // |winding number| > 1/2
+        return true;
+    }
+    return false;
   }
 
   // Do the projections of a and b on axis u leave a gap of at least `gap` (either order)? The
@@ -1152,6 +1211,7 @@ private:
   }
 
   const TriangleTree& Input;
+  std::vector<Vec3> Probes; ///< one input point per component, sorted by x (see sweepsProbe)
   SimplifyOptions Opt;
   const SimplifyOptions Original;
   Progress* Prog;
@@ -1182,7 +1242,7 @@ private:
 } // namespace
 
 SimplifyResult simplifyEnvelope(const TriangleMesh& envelope, const TriangleTree& inputTree,
-  const SimplifyOptions& options, Progress* progress)
+  const SimplifyOptions& options, Progress* progress, const std::vector<Vec3>* inputProbes)
 {
   if (envelope.Triangles.empty())
   {
@@ -1190,7 +1250,7 @@ SimplifyResult simplifyEnvelope(const TriangleMesh& envelope, const TriangleTree
     r.StopReason = "empty envelope";
     return r;
   }
-  Simplifier s(envelope, inputTree, options, progress);
+  Simplifier s(envelope, inputTree, options, progress, inputProbes);
   return s.run();
 }
 

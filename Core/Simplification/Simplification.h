@@ -68,7 +68,11 @@ struct SimplifyResult
 /// collapses are evaluated in batches of well-separated edges on all threads and applied in queue
 /// order; an evaluation whose neighbourhood an earlier collapse changed is repeated later.
 /// Deterministic: the batches do not depend on the thread count, nor does the cage.
+/// `inputProbes` (componentProbes() of the normalized input): no collapse may sweep one of
+/// them out of the cage. Needed whenever the input has components smaller than the cage's
+/// triangles (soups, scans with debris); the pipeline always passes them.
 SimplifyResult simplifyEnvelope(const TriangleMesh& envelope, const TriangleTree& inputTree,
-  const SimplifyOptions& options, Progress* progress = nullptr);
+  const SimplifyOptions& options, Progress* progress = nullptr,
+  const std::vector<Vec3>* inputProbes = nullptr);
 
 } // namespace sdfcage

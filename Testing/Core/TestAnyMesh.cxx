@@ -226,6 +226,28 @@ std::vector<Case> cases()
       },
       SignMode::WindingNumber, 30 },
     { "OpenPlaneSheet", [] { return PolygonMesh::fromTriangles(sheet(20)); }, SignMode::WindingNumber, 100 },
+    { "SphereWithDebris",
+      [] {
+        // 80 tiny triangles (0.004 across) floating 0.016 above a sphere: their offsets fuse with
+        // the sphere's into bumps, which the simplification flattens; without the swept-region
+        // test a collapse jumps over a fragment and leaves it outside (no new triangle comes near)
+        TriangleMesh m = makeSphere(Vec3(0, 0, 0), 1.0, 32, 16);
+        for (int i = 0; i < 80; ++i)
+        {
+          // a Fibonacci spiral of directions
+          const double z = 1.0 - (i + 0.5) / 40.0, r = std::sqrt(1.0 - z * z), phi = 2.399963 * i;
+          const Vec3 u(r * std::cos(phi), r * std::sin(phi), z);
+          const Vec3 a = u.unitOrthogonal(), b = u.cross(a);
+          const Vec3 c = 1.016 * u;
+          const int base = static_cast<int>(m.Points.size());
+          m.Points.push_back(c + 0.002 * a);
+          m.Points.push_back(c - 0.001 * a + 0.0017 * b);
+          m.Points.push_back(c - 0.001 * a - 0.0017 * b);
+          m.Triangles.push_back({ base, base + 1, base + 2 });
+        }
+        return PolygonMesh::fromTriangles(m);
+      },
+      SignMode::WindingNumber, 100 },
   };
 }
 
