@@ -418,29 +418,64 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
     openvdb::tree::LeafManager<openvdb::FloatTree> leaves(grid->tree());
     std::atomic<std::size_t> evaluated{ 0 }, inside{ 0 };
     const float isoF = static_cast<float>(iso);
+    // By blocks of 2x2x2 voxels: one evaluation at the block's centre decides all of the block's
+    // voxels at or beyond the isovalue when it is clearly on one side (|w| < 1/4 or > 3/4). Such a
+    // voxel is at least 2 voxels from the input and at most 0.87 from the centre, so the segment
+    // between them stays 1.13 voxels away and w changes along it by about 0.12 per open border
+    // nearby (w = angle / 2 pi beside a border); blocks nearer 1/2 are evaluated voxel by voxel.
+    // (4-8x fewer evaluations, the cost of the winding-number sign.)
     tbb::parallel_for(leaves.leafRange(), [&](const openvdb::tree::LeafManager<openvdb::FloatTree>::LeafRange& r) {
       std::size_t e = 0, in = 0;
+      using LeafT = openvdb::FloatTree::LeafNodeType;
       for (auto leaf = r.begin(); leaf; ++leaf)
       {
         if (progressCancelled(progress))
         {
           return;
         }
-        for (auto v = leaf->beginValueOn(); v; ++v)
-        {
-          if (*v < isoF)
-          {
-            continue;
-          }
-          const openvdb::Coord ijk = v.getCoord();
-          const Vec3 x(ijk.x() * voxelSize, ijk.y() * voxelSize, ijk.z() * voxelSize);
-          ++e;
-          if (std::abs(windingTree->windingNumber(x)) > 0.5)
-          {
-            v.setValue(-*v);
-            ++in;
-          }
-        }
+        const openvdb::Coord origin = leaf->origin();
+        for (int bx = 0; bx < 8; bx += 2)
+          for (int by = 0; by < 8; by += 2)
+            for (int bz = 0; bz < 8; bz += 2)
+            {
+              openvdb::Index far[8];
+              int nfar = 0;
+              for (int i = 0; i < 2; ++i)
+                for (int j = 0; j < 2; ++j)
+                  for (int k = 0; k < 2; ++k)
+                  {
+                    const openvdb::Index o = LeafT::coordToOffset(origin.offsetBy(bx + i, by + j, bz + k));
+                    if (leaf->isValueOn(o) && leaf->getValue(o) >= isoF)
+                      far[nfar++] = o;
+                  }
+              if (nfar == 0)
+                continue;
+              int decided = -1; // 1 inside, 0 outside, -1 voxel by voxel
+              if (nfar > 1)
+              {
+                const Vec3 c((origin.x() + bx + 0.5) * voxelSize, (origin.y() + by + 0.5) * voxelSize,
+                  (origin.z() + bz + 0.5) * voxelSize);
+                const double w = std::abs(windingTree->windingNumber(c));
+                ++e;
+                decided = w < 0.25 ? 0 : w > 0.75 ? 1 : -1;
+              }
+              for (int q = 0; q < nfar; ++q)
+              {
+                bool in1 = decided == 1;
+                if (decided < 0)
+                {
+                  const openvdb::Coord ijk = LeafT::offsetToLocalCoord(far[q]) + origin;
+                  const Vec3 x(ijk.x() * voxelSize, ijk.y() * voxelSize, ijk.z() * voxelSize);
+                  ++e;
+                  in1 = std::abs(windingTree->windingNumber(x)) > 0.5;
+                }
+                if (in1)
+                {
+                  leaf->setValueOnly(far[q], -leaf->getValue(far[q]));
+                  ++in;
+                }
+              }
+            }
       }
       evaluated += e;
       inside += in;

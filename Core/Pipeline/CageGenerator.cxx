@@ -6,7 +6,12 @@
 
 #include <tbb/global_control.h>
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <iomanip>
+#include <sstream>
+#include <string>
 #include <memory>
 
 namespace sdfcage
@@ -33,7 +38,20 @@ ScalarImage imageToInput(ScalarImage image, const Normalization& n)
 
 namespace
 {
-CageResult generateOnce(const PolygonMesh& input, const CageOptions& options, Progress* progress)
+/// About the fewest vertices a cage of `components` parts and total genus `genus` can have: 4 per
+/// part (a tetrahedron) and 8 per handle. The smallest triangulated torus has 7 vertices and a
+/// genus-g surface at least (7 + sqrt(1 + 48 g)) / 2 (Heawood), but those are far too twisted to
+/// keep clear of an input: a handle that does needs a ring of 3 or more vertices around it, 3 or
+/// more along it (the 500-vertex target fails on envelopes of genus 100 or more).
+int minimumVertices(int components, int genus)
+{
+  return components <= 0 ? 0 : 4 * components + 8 * std::max(genus, 0);
+}
+
+/// One run of the pipeline. `mayWiden`: a wider envelope will be tried if this one cannot carry
+/// the target, so an envelope whose topology needs more vertices than the target is not
+/// simplified (it could not reach the target; the time is better spent on the wider one).
+CageResult generateOnce(const PolygonMesh& input, const CageOptions& options, Progress* progress, bool mayWiden)
 {
   CageResult result;
   result.IsoValueUsed = options.Envelope.IsoValue;
@@ -117,6 +135,20 @@ CageResult generateOnce(const PolygonMesh& input, const CageOptions& options, Pr
   }
 
   // 4. the cage: constrained simplification of the verified envelope, verified again
+  const int needed = minimumVertices(env.Components, env.Genus);
+  if (mayWiden && !env.InputClosed && options.TargetNumberOfVertices > 0 && needed > options.TargetNumberOfVertices)
+  {
+    result.State = Status::Failed;
+    result.EnvelopeTooComplex = true;
+    result.VerticesReached = static_cast<int>(env.Envelope.Points.size());
+    result.EnvelopeComponents = env.Components;
+    result.EnvelopeGenus = env.Genus;
+    result.TargetReached = false;
+    result.Message = result.StopReason = "the envelope has " + std::to_string(env.Components) + " parts and genus " +
+      std::to_string(env.Genus) + ": a cage like it needs about " + std::to_string(needed) + " vertices or more";
+    result.TotalSeconds = seconds(start);
+    return result;
+  }
   if (options.TargetNumberOfVertices <= 0)
   {
     result.Cage = result.Envelope;
@@ -202,24 +234,38 @@ CageResult generateOnce(const PolygonMesh& input, const CageOptions& options, Pr
 bool wantsWidening(const CageResult& r, const CageOptions& options, int done, Progress* progress)
 {
   return done < options.MaximumEnvelopeWidenings && options.TargetNumberOfVertices > 0 &&
-    r.State == Status::Ok && !r.TargetReached && !r.InputClosed && !progressCancelled(progress);
+    ((r.State == Status::Ok && !r.TargetReached) || r.EnvelopeTooComplex) && !r.InputClosed &&
+    !progressCancelled(progress);
 }
 } // namespace
 
 CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Progress* progress)
 {
   const auto start = std::chrono::steady_clock::now();
-  CageResult best = generateOnce(input, options, progress);
+  CageResult best = generateOnce(input, options, progress, options.MaximumEnvelopeWidenings > 0);
   CageOptions wider = options;
   int tried = 0;
+  std::string log;
+  auto note = [&log](const CageResult& r) {
+    std::ostringstream s;
+    s << (log.empty() ? "" : "; ") << "isovalue " << r.IsoValueUsed << ": envelope of " << r.EnvelopeComponents
+      << " part(s), genus " << r.EnvelopeGenus << ", "
+      << (r.EnvelopeTooComplex ? std::string("not simplified") : std::to_string(r.VerticesReached) + " vertices")
+      << " (" << std::setprecision(3) << r.TotalSeconds << " s)";
+    log += s.str();
+  };
   for (int k = 0; wantsWidening(best, options, k, progress); ++k)
   {
+    if (k == 0)
+      note(best);
     tried = k + 1;
     wider.Envelope.IsoValue *= 2.0;
     progressStage(progress, "widening the envelope to reach the target", 0.0, 1.0);
-    CageResult next = generateOnce(input, wider, progress);
-    // keep the cage that reaches the target, or the one closest to it (ties: the tighter one)
-    if (next.State == Status::Ok && next.VerticesReached < best.VerticesReached)
+    CageResult next = generateOnce(input, wider, progress, k + 1 < options.MaximumEnvelopeWidenings);
+    note(next);
+    // keep the cage that reaches the target, or the one closest to it (on a tie, the tighter first one)
+    if ((next.State == Status::Ok || next.EnvelopeTooComplex) &&
+      (best.EnvelopeTooComplex || next.VerticesReached < best.VerticesReached))
     {
       next.EnvelopeWidenings = k + 1;
       next.StopReason = next.TargetReached ? std::string() : next.StopReason;
@@ -232,9 +278,9 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
   }
   if (tried > 0 && !best.TargetReached && best.State == Status::Ok)
   {
-    best.StopReason += "; envelopes widened up to isovalue " + std::to_string(wider.Envelope.IsoValue) +
-      " did not get closer to the target";
+    best.StopReason += "; the envelope was widened " + std::to_string(tried) + " time(s), the cage with the fewest vertices is kept";
   }
+  best.WideningLog = log;
   best.TotalSeconds = seconds(start);
   return best;
 }

@@ -28,10 +28,10 @@ struct CageOptions
   /// of a model). When the target is not reached for such an input, the envelope is built again
   /// with twice the isovalue (the automatic voxel size and clearance follow it), which fuses
   /// parts and closes handles narrower than about twice the new isovalue, up to this many
-  /// times; the cage that reaches the target (or gets closest) is kept and IsoValueUsed /
+  /// times (2, 4, 8 times the isovalue); the cage that reaches the target (or gets closest) is kept and IsoValueUsed /
   /// EnvelopeWidenings say what was done. Closed inputs are never widened (their topology is
   /// kept). 0 = off.
-  int MaximumEnvelopeWidenings = 2;
+  int MaximumEnvelopeWidenings = 3;
 };
 
 struct CageResult
@@ -79,6 +79,11 @@ struct CageResult
   double TotalSeconds = 0.0;
   double IsoValueUsed = 0.0;        ///< unit-sphere units: the requested one, or widened (see MaximumEnvelopeWidenings)
   int EnvelopeWidenings = 0;        ///< envelopes rebuilt with twice the isovalue to reach the target
+  /// This run's envelope has more parts and handles than the target's vertices can carry, and
+  /// was not simplified because a wider one is tried next (see MaximumEnvelopeWidenings).
+  bool EnvelopeTooComplex = false;
+  /// One entry per envelope built when widening: isovalue, parts, genus, vertices reached, time.
+  std::string WideningLog;
   ScalarImage DistanceField;        ///< input coordinates and units, when requested
   ScalarImage ModifiedDistanceField; ///< phi * xi, input units, when requested and active points exist
   Normalization Normalize;

@@ -55,6 +55,7 @@ std::vector<ResultField> inputResults(const CageResult& r)
     real("WindingTime", r.WindingSeconds, "s", "winding-number sign (part of DistanceFieldTime)"),
     real("IsoValueUsed", r.IsoValueUsed, "relative", "isovalue of the envelope the cage comes from (unit-sphere units)"),
     integer("EnvelopeWidenings", r.EnvelopeWidenings, "count", "envelopes rebuilt with twice the isovalue to reach the target (inputs without a defined topology only)"),
+    text("WideningLog", r.WideningLog, "each envelope tried when widening: isovalue, parts, genus, vertices reached, time"),
   };
 }
 
