@@ -128,7 +128,8 @@ TEST(DataMesh, GenerateCage)
     const TriangleMesh* Mesh;
     double Limit;
   };
-  const Checked checks[2] = { { "envelope", &result.Envelope, n.lengthToInput(2.0 * options.Envelope.IsoValue) },
+  // (the isovalue used: inputs without a defined topology may have had their envelope widened)
+  const Checked checks[2] = { { "envelope", &result.Envelope, n.lengthToInput(2.0 * result.IsoValueUsed) },
     { "cage", &result.Cage, n.lengthToInput(0.25) } };
   exact::ExactReport reports[2];
   for (int k = 0; k < 2; ++k)
