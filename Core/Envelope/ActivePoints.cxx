@@ -16,6 +16,7 @@
 #include <memory>
 #include <sstream>
 #include <unordered_map>
+#include <utility>
 
 namespace sdfcage
 {
@@ -183,45 +184,399 @@ struct EdgeGraph
   }
 };
 
-using HeapEntry = std::pair<double, int>;
-
-/// Per-thread Dijkstra state, reset in O(1) by stamps.
-struct Search
+/// Shortest paths along the edges of an EdgeGraph from one or more sources, out to a radius
+/// (Dijkstra with a bound). The per-point state is reset in O(1) by a stamp, so one object serves
+/// any number of searches: keep one per thread.
+class BoundedDijkstra
 {
+public:
+  explicit BoundedDijkstra(const EdgeGraph& graph)
+    : Graph(&graph)
+    , Dist(graph.Start.size() - 1, 0.0)
+    , Seen(graph.Start.size() - 1, 0)
+    , Settled(graph.Start.size() - 1, 0)
+  {
+  }
+
+  /// Starts a new search: forgets every point reached before and every source.
+  void restart()
+  {
+    if (++this->Now == 0)
+    {
+      std::fill(this->Seen.begin(), this->Seen.end(), 0);
+      std::fill(this->Settled.begin(), this->Settled.end(), 0);
+      this->Now = 1;
+    }
+    this->Heap.clear();
+  }
+
+  /// Adds a source (distance 0) to the current search.
+  void addSource(int p)
+  {
+    this->Dist[p] = 0.0;
+    this->Seen[p] = this->Now;
+    this->push(0.0, p);
+  }
+
+  /// Settles points in increasing distance from the sources, up to `radius` (inclusive):
+  /// visit(u, d) is called on each settled point u at distance d and returns false to end the
+  /// search there.
+  template <typename Visit>
+  void run(double radius, Visit&& visit)
+  {
+    const EdgeGraph& graph = *this->Graph;
+    const std::uint32_t now = this->Now;
+    while (!this->Heap.empty())
+    {
+      const auto [d, u] = this->pop();
+      if (this->Settled[u] == now || d > this->Dist[u])
+      {
+        continue;
+      }
+      this->Settled[u] = now;
+      if (!visit(u, d))
+      {
+        return;
+      }
+      for (std::size_t e = graph.Start[u]; e < graph.Start[u + 1]; ++e)
+      {
+        const int v = graph.Neighbor[e];
+        const double nd = d + graph.Length[e];
+        if (nd > radius || this->Settled[v] == now)
+        {
+          continue;
+        }
+        if (this->Seen[v] != now || nd < this->Dist[v])
+        {
+          this->Seen[v] = now;
+          this->Dist[v] = nd;
+          this->push(nd, v);
+        }
+      }
+    }
+  }
+
+  /// A new search from one source.
+  template <typename Visit>
+  void run(int source, double radius, Visit&& visit)
+  {
+    this->restart();
+    this->addSource(source);
+    this->run(radius, std::forward<Visit>(visit));
+  }
+
+  /// Was v settled by the current search (its distance known, and within the radius)?
+  bool settled(int v) const { return this->Settled[v] == this->Now; }
+
+private:
+  using Entry = std::pair<double, int>;
+  void push(double d, int v)
+  {
+    this->Heap.emplace_back(d, v);
+    std::push_heap(this->Heap.begin(), this->Heap.end(), std::greater<Entry>());
+  }
+  Entry pop()
+  {
+    std::pop_heap(this->Heap.begin(), this->Heap.end(), std::greater<Entry>());
+    const Entry e = this->Heap.back();
+    this->Heap.pop_back();
+    return e;
+  }
+
+  const EdgeGraph* Graph;
   std::vector<double> Dist;
   std::vector<std::uint32_t> Seen;    // Dist valid when Seen == Now
   std::vector<std::uint32_t> Settled; // settled when == Now
-  std::vector<std::uint32_t> Target;  // a Euclidean neighbour of the source when == Now
-  std::vector<HeapEntry> Heap;
-  std::vector<int> Targets;
+  std::vector<Entry> Heap;
   std::uint32_t Now = 0;
-
-  explicit Search(std::size_t n)
-    : Dist(n, 0.0)
-    , Seen(n, 0)
-    , Settled(n, 0)
-    , Target(n, 0)
-  {
-  }
 };
-
-void pushHeap(std::vector<HeapEntry>& h, double d, int v)
-{
-  h.emplace_back(d, v);
-  std::push_heap(h.begin(), h.end(), std::greater<HeapEntry>());
-}
-
-HeapEntry popHeap(std::vector<HeapEntry>& h)
-{
-  std::pop_heap(h.begin(), h.end(), std::greater<HeapEntry>());
-  HeapEntry e = h.back();
-  h.pop_back();
-  return e;
-}
 
 double seconds(std::chrono::steady_clock::time_point t0)
 {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// Points referenced by a triangle (unreferenced input points take no part).
+std::vector<char> referencedPoints(const TriangleMesh& mesh)
+{
+  std::vector<char> referenced(mesh.Points.size(), 0);
+  for (const Triangle& t : mesh.Triangles)
+  {
+    referenced[t[0]] = referenced[t[1]] = referenced[t[2]] = 1;
+  }
+  return referenced;
+}
+
+/// Sampling: greedy, in point order (deterministic): a referenced point not yet within
+/// `separation` of a sample *along the surface* becomes one. (A Euclidean cover would let one
+/// part's samples stand for a nearly touching other part, which then has no samples of its own.)
+std::vector<int> sampleSurface(const EdgeGraph& graph, const std::vector<char>& referenced, double separation)
+{
+  std::vector<int> samples;
+  std::vector<char> covered(referenced.size(), 0);
+  BoundedDijkstra cover(graph);
+  for (std::size_t i = 0; i < referenced.size(); ++i)
+  {
+    if (!referenced[i] || covered[i])
+    {
+      continue;
+    }
+    samples.push_back(static_cast<int>(i));
+    cover.run(static_cast<int>(i), separation, [&](int u, double) {
+      covered[u] = 1;
+      return true;
+    });
+  }
+  return samples;
+}
+
+/// Centres of the certificate balls: the first sample (in point order) of every occupied cell of
+/// side reach / sqrt(3), so every sample lies within `reach` of the centre of its cell.
+std::vector<int> ballCentres(const std::vector<Vec3>& points, const std::vector<int>& samples, double reach)
+{
+  std::vector<int> centres;
+  if (!(reach > 0))
+  {
+    return centres;
+  }
+  const double cell = reach / std::sqrt(3.0);
+  std::vector<std::pair<std::array<std::int64_t, 3>, int>> keyed(samples.size());
+  for (std::size_t k = 0; k < samples.size(); ++k)
+  {
+    const Vec3& x = points[samples[k]];
+    keyed[k] = { { static_cast<std::int64_t>(std::floor(x.x() / cell)), static_cast<std::int64_t>(std::floor(x.y() / cell)),
+                   static_cast<std::int64_t>(std::floor(x.z() / cell)) },
+      samples[k] };
+  }
+  std::sort(keyed.begin(), keyed.end());
+  for (std::size_t k = 0; k < keyed.size(); ++k)
+  {
+    if (k == 0 || keyed[k].first != keyed[k - 1].first)
+    {
+      centres.push_back(keyed[k].second);
+    }
+  }
+  return centres;
+}
+
+/// The active samples (paper §3.1): a sample p is active when some other sample q closer than r
+/// to p (a candidate) is farther than l from p along the surface. Each sample not settled
+/// otherwise goes through the steps: candidate search within r, geodesic test against l,
+/// marking (p and every candidate farther than l). A cheaper pass first certifies most samples
+/// inactive (certifyInactiveByBalls). Threaded; every thread keeps its own search.
+class ActiveSampleDetection
+{
+public:
+  ActiveSampleDetection(const TriangleMesh& surface, const EdgeGraph& graph, const std::vector<int>& samples,
+    double r, double l, Progress* progress)
+    : Points(surface.Points)
+    , Samples(samples)
+    , R(r)
+    , L(l)
+    , SampleGrid(surface.Points, samples, r)
+    , Active(new std::atomic<std::uint8_t>[surface.Points.size()])
+    , Certified(new std::atomic<std::uint8_t>[surface.Points.size()])
+    , Scratches([g = &graph]() { return Scratch(*g); })
+    , Report(progress)
+  {
+    for (std::size_t i = 0; i < surface.Points.size(); ++i)
+    {
+      this->Active[i].store(0, std::memory_order_relaxed);
+      this->Certified[i].store(0, std::memory_order_relaxed);
+    }
+  }
+
+  /// Finds the active samples; false when cancelled.
+  bool run()
+  {
+    const double reach = std::max(0.0, 0.5 * this->L - this->R);
+    const std::vector<int> centres = ballCentres(this->Points, this->Samples, reach);
+    this->Work = centres.size() + this->Samples.size();
+    this->certifyInactiveByBalls(centres, reach);
+    this->testSamples();
+    return !this->Cancelled.load();
+  }
+
+  bool isActive(int p) const { return this->Active[p].load(std::memory_order_relaxed) != 0; }
+
+private:
+  struct Scratch
+  {
+    explicit Scratch(const EdgeGraph& graph)
+      : Search(graph)
+      , IsCandidate(graph.Start.size() - 1, 0)
+    {
+    }
+    BoundedDijkstra Search;
+    std::vector<char> IsCandidate; // 0 outside testSample()
+    std::vector<int> Candidates;            // of the sample being tested
+    std::vector<int> Unsettled, Certifiable; // near the ball being certified
+  };
+
+  /// Cheap certificates: one search of radius l/2 from a centre c settles a ball B; a sample q in
+  /// B all of whose candidates are in B is not active, since g(q, w) <= g(q, c) + g(c, w) <= l
+  /// for each candidate w. The centres are spread so that these balls cover the surface; most
+  /// samples are settled here at a fraction of a search each.
+  void certifyInactiveByBalls(const std::vector<int>& centres, double reach)
+  {
+    const double half = 0.5 * this->L, r = this->R;
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, centres.size(), 16), [&](const tbb::blocked_range<std::size_t>& range) {
+      if (this->Cancelled.load(std::memory_order_relaxed))
+      {
+        return;
+      }
+      Scratch& s = this->Scratches.local();
+      for (std::size_t k = range.begin(); k != range.end(); ++k)
+      {
+        const int c = centres[k];
+        s.Search.run(c, half, [](int, double) { return true; });
+        // a sample within `reach` (Euclidean) of c has all its candidates within reach + r of c:
+        // it is certified unless one of those is unsettled and near it
+        s.Unsettled.clear();
+        s.Certifiable.clear();
+        const Vec3& x = this->Points[c];
+        const double reach2 = reach * reach;
+        this->SampleGrid.forEachWithin(x, reach + r, [&](int w) {
+          if (!s.Search.settled(w))
+          {
+            s.Unsettled.push_back(w);
+          }
+          else if ((this->Points[w] - x).squaredNorm() <= reach2 && !this->Certified[w].load(std::memory_order_relaxed))
+          {
+            s.Certifiable.push_back(w);
+          }
+        });
+        const double r2 = r * r;
+        for (int q : s.Certifiable)
+        {
+          bool ok = true;
+          for (int u : s.Unsettled)
+          {
+            if ((this->Points[u] - this->Points[q]).squaredNorm() < r2)
+            {
+              ok = false;
+              break;
+            }
+          }
+          if (ok)
+          {
+            this->Certified[q].store(1, std::memory_order_relaxed);
+          }
+        }
+      }
+      this->advance(range.size());
+    });
+  }
+
+  /// Every sample neither certified nor already found active goes through the three steps.
+  void testSamples()
+  {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, this->Samples.size(), 512),
+      [&](const tbb::blocked_range<std::size_t>& range) {
+        if (this->Cancelled.load(std::memory_order_relaxed))
+        {
+          return;
+        }
+        Scratch& s = this->Scratches.local();
+        for (std::size_t k = range.begin(); k != range.end(); ++k)
+        {
+          const int p = this->Samples[k];
+          if (this->isActive(p) || this->Certified[p].load(std::memory_order_relaxed))
+          {
+            continue;
+          }
+          this->findCandidates(p, s);
+          if (!s.Candidates.empty() && !this->geodesicTest(p, s))
+          {
+            this->markActive(p, s);
+          }
+          for (int q : s.Candidates)
+          {
+            s.IsCandidate[q] = 0;
+          }
+        }
+        this->advance(range.size());
+      });
+  }
+
+  /// Candidate search within r: the other samples closer than r to p (Euclidean).
+  void findCandidates(int p, Scratch& s) const
+  {
+    s.Candidates.clear();
+    this->SampleGrid.forEachWithin(this->Points[p], this->R, [&](int q) {
+      if (q != p)
+      {
+        s.Candidates.push_back(q);
+        s.IsCandidate[q] = 1;
+      }
+    });
+  }
+
+  /// Geodesic test against l: a search from p bounded by l, ended as soon as every candidate is
+  /// settled. True when every candidate is within l of p along the surface.
+  bool geodesicTest(int p, Scratch& s) const
+  {
+    std::size_t remaining = s.Candidates.size();
+    s.Search.run(p, this->L, [&](int u, double) { return !(s.IsCandidate[u] && --remaining == 0); });
+    return remaining == 0;
+  }
+
+  /// Marking: some candidate is farther than l along the surface (not reached by the test's
+  /// search): p is active, and so is every candidate not reached.
+  void markActive(int p, const Scratch& s)
+  {
+    this->Active[p].store(1, std::memory_order_relaxed);
+    for (int q : s.Candidates)
+    {
+      if (!s.Search.settled(q))
+      {
+        this->Active[q].store(1, std::memory_order_relaxed);
+      }
+    }
+  }
+
+  void advance(std::size_t steps)
+  {
+    const std::size_t total = this->Done.fetch_add(steps) + steps;
+    if (progressUpdate(this->Report, 0.1 + 0.8 * static_cast<double>(total) / this->Work))
+    {
+      this->Cancelled.store(true);
+    }
+  }
+
+  const std::vector<Vec3>& Points;
+  const std::vector<int>& Samples;
+  const double R, L;
+  const PointGrid SampleGrid;
+  std::unique_ptr<std::atomic<std::uint8_t>[]> Active, Certified;
+  tbb::enumerable_thread_specific<Scratch> Scratches;
+  Progress* Report;
+  std::size_t Work = 0;
+  std::atomic<std::size_t> Done{ 0 };
+  std::atomic<bool> Cancelled{ false };
+};
+
+/// g_A: the geodesic distance to the nearest active sample, from one search with all of them as
+/// sources, up to the cutoff (points beyond keep it). Returns the number of active samples.
+std::size_t geodesicToActive(const EdgeGraph& graph, const std::vector<int>& samples,
+  const ActiveSampleDetection& detection, double cutoff, std::vector<double>& g)
+{
+  BoundedDijkstra spread(graph);
+  spread.restart();
+  std::size_t sources = 0;
+  for (int p : samples)
+  {
+    if (detection.isActive(p))
+    {
+      spread.addSource(p);
+      ++sources;
+    }
+  }
+  spread.run(cutoff, [&](int u, double d) {
+    g[u] = d;
+    return true;
+  });
+  return sources;
 }
 
 } // namespace
@@ -406,8 +761,6 @@ ActivePoints computeActivePoints(const TriangleMesh& unitInput, const ActivePoin
   result.Cutoff = options.geodesicCutoff();
   result.NumberOfInputPoints = unitInput.Points.size();
   const double spacing = options.sampleSpacing();
-  const double r = options.Radius;
-  const double l = options.GeodesicThreshold;
 
   refineMesh(unitInput, spacing, result.Surface);
   const TriangleMesh& S = result.Surface;
@@ -421,316 +774,29 @@ ActivePoints computeActivePoints(const TriangleMesh& unitInput, const ActivePoin
     return result;
   }
 
-  // Referenced points only (unreferenced input points take no part).
-  std::vector<char> referenced(n, 0);
-  for (const Triangle& t : S.Triangles)
-  {
-    referenced[t[0]] = referenced[t[1]] = referenced[t[2]] = 1;
-  }
-  std::vector<int> all;
-  all.reserve(n);
-  for (std::size_t i = 0; i < n; ++i)
-  {
-    if (referenced[i])
-    {
-      all.push_back(static_cast<int>(i));
-    }
-  }
-
-  // Samples: greedy, in point order (deterministic): a point not yet within half a spacing of a
-  // sample *along the surface* becomes one. (A Euclidean cover would let one part's samples
-  // stand for a nearly touching other part, which then has no samples of its own.)
+  // sampling: samples half a spacing apart along the surface
   const EdgeGraph graph(S);
   const double separation = 0.5 * spacing;
-  std::vector<int> samples;
-  {
-    std::vector<char> covered(n, 0);
-    Search cover(n);
-    for (int id : all)
-    {
-      if (covered[id])
-      {
-        continue;
-      }
-      samples.push_back(id);
-      const std::uint32_t now = ++cover.Now;
-      cover.Heap.clear();
-      cover.Dist[id] = 0.0;
-      cover.Seen[id] = now;
-      pushHeap(cover.Heap, 0.0, id);
-      while (!cover.Heap.empty())
-      {
-        const auto [d, u] = popHeap(cover.Heap);
-        if (cover.Settled[u] == now || d > cover.Dist[u])
-        {
-          continue;
-        }
-        cover.Settled[u] = now;
-        covered[u] = 1;
-        for (std::size_t e = graph.Start[u]; e < graph.Start[u + 1]; ++e)
-        {
-          const int v = graph.Neighbor[e];
-          const double nd = d + graph.Length[e];
-          if (nd <= separation && cover.Settled[v] != now && (cover.Seen[v] != now || nd < cover.Dist[v]))
-          {
-            cover.Seen[v] = now;
-            cover.Dist[v] = nd;
-            pushHeap(cover.Heap, nd, v);
-          }
-        }
-      }
-    }
-  }
+  const std::vector<char> referenced = referencedPoints(S);
+  const std::vector<int> samples = sampleSurface(graph, referenced, separation);
   result.NumberOfSamples = samples.size();
   progressUpdate(progress, 0.1);
 
-  const PointGrid sampleGrid(S.Points, samples, r);
-  std::unique_ptr<std::atomic<std::uint8_t>[]> active(new std::atomic<std::uint8_t>[n]);
-  for (std::size_t i = 0; i < n; ++i)
-  {
-    active[i].store(0, std::memory_order_relaxed);
-  }
-
-  tbb::enumerable_thread_specific<Search> searches([n]() { return Search(n); });
-  std::atomic<bool> cancelled{ false };
-  auto nextStamp = [](Search& s) {
-    if (++s.Now == 0)
-    {
-      std::fill(s.Seen.begin(), s.Seen.end(), 0);
-      std::fill(s.Settled.begin(), s.Settled.end(), 0);
-      std::fill(s.Target.begin(), s.Target.end(), 0);
-      s.Now = 1;
-    }
-    return s.Now;
-  };
-  // Bounded Dijkstra from p; `visit(u, d)` is called on every settled point and returns false to
-  // stop the search.
-  auto dijkstra = [&](Search& s, int p, double limit, auto&& visit) {
-    const std::uint32_t now = s.Now;
-    s.Heap.clear();
-    s.Dist[p] = 0.0;
-    s.Seen[p] = now;
-    pushHeap(s.Heap, 0.0, p);
-    while (!s.Heap.empty())
-    {
-      const auto [d, u] = popHeap(s.Heap);
-      if (s.Settled[u] == now || d > s.Dist[u])
-      {
-        continue;
-      }
-      s.Settled[u] = now;
-      if (!visit(u, d))
-      {
-        return;
-      }
-      for (std::size_t e = graph.Start[u]; e < graph.Start[u + 1]; ++e)
-      {
-        const int v = graph.Neighbor[e];
-        const double nd = d + graph.Length[e];
-        if (nd > limit || s.Settled[v] == now)
-        {
-          continue;
-        }
-        if (s.Seen[v] != now || nd < s.Dist[v])
-        {
-          s.Seen[v] = now;
-          s.Dist[v] = nd;
-          pushHeap(s.Heap, nd, v);
-        }
-      }
-    }
-  };
-
-  // Phase 1 (cheap certificates): one search of radius l/2 from a centre c settles a ball B; a
-  // sample q in B all of whose Euclidean neighbours are in B is not active, since
-  // g(q, w) <= g(q, c) + g(c, w) <= l for each neighbour w. Centres are spread so that these
-  // balls cover the surface; most samples are settled here at a fraction of a search each.
-  std::unique_ptr<std::atomic<std::uint8_t>[]> certified(new std::atomic<std::uint8_t>[n]);
-  std::vector<char> isSample(n, 0);
-  for (std::size_t i = 0; i < n; ++i)
-  {
-    certified[i].store(0, std::memory_order_relaxed);
-  }
-  for (int q : samples)
-  {
-    isSample[q] = 1;
-  }
-  const double half = 0.5 * l;
-  const double reach = std::max(0.0, half - r);
-  // centres: the first sample (in point order) of every occupied cell of side reach / sqrt(3),
-  // so every sample lies within `reach` of the centre of its cell
-  std::vector<int> centres;
-  if (reach > 0)
-  {
-    const double cell = reach / std::sqrt(3.0);
-    std::vector<std::pair<std::array<std::int64_t, 3>, int>> keyed(samples.size());
-    for (std::size_t k = 0; k < samples.size(); ++k)
-    {
-      const Vec3& x = S.Points[samples[k]];
-      keyed[k] = { { static_cast<std::int64_t>(std::floor(x.x() / cell)), static_cast<std::int64_t>(std::floor(x.y() / cell)),
-                     static_cast<std::int64_t>(std::floor(x.z() / cell)) },
-        samples[k] };
-    }
-    std::sort(keyed.begin(), keyed.end());
-    for (std::size_t k = 0; k < keyed.size(); ++k)
-    {
-      if (k == 0 || keyed[k].first != keyed[k - 1].first)
-      {
-        centres.push_back(keyed[k].second);
-      }
-    }
-  }
-  std::atomic<std::size_t> done{ 0 };
-  const std::size_t work = centres.size() + samples.size();
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, centres.size(), 16),
-    [&](const tbb::blocked_range<std::size_t>& range) {
-      if (cancelled.load(std::memory_order_relaxed))
-      {
-        return;
-      }
-      Search& s = searches.local();
-      std::vector<int> unsettled, candidates;
-      for (std::size_t k = range.begin(); k != range.end(); ++k)
-      {
-        const int c = centres[k];
-        const std::uint32_t now = nextStamp(s);
-        dijkstra(s, c, half, [](int, double) { return true; });
-        // a sample within `reach` (Euclidean) of c has all its Euclidean neighbours within
-        // reach + r of c: it is certified unless one of those is unsettled and near it
-        unsettled.clear();
-        candidates.clear();
-        const Vec3& x = S.Points[c];
-        const double reach2 = reach * reach;
-        sampleGrid.forEachWithin(x, reach + r, [&](int w) {
-          if (s.Settled[w] != now)
-          {
-            unsettled.push_back(w);
-          }
-          else if ((S.Points[w] - x).squaredNorm() <= reach2 && !certified[w].load(std::memory_order_relaxed))
-          {
-            candidates.push_back(w);
-          }
-        });
-        const double r2 = r * r;
-        for (int q : candidates)
-        {
-          bool ok = true;
-          for (int u : unsettled)
-          {
-            if ((S.Points[u] - S.Points[q]).squaredNorm() < r2)
-            {
-              ok = false;
-              break;
-            }
-          }
-          if (ok)
-          {
-            certified[q].store(1, std::memory_order_relaxed);
-          }
-        }
-      }
-      const std::size_t total = done.fetch_add(range.size()) + range.size();
-      if (progressUpdate(progress, 0.1 + 0.8 * static_cast<double>(total) / work))
-      {
-        cancelled.store(true);
-      }
-    });
-
-  // Phase 2: every other sample p gets its own search, ended as soon as every Euclidean
-  // neighbour is settled (p is not active) or when the radius l is exhausted (p is active, and
-  // so is every neighbour not reached).
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, samples.size(), 512),
-    [&](const tbb::blocked_range<std::size_t>& range) {
-      if (cancelled.load(std::memory_order_relaxed))
-      {
-        return;
-      }
-      Search& s = searches.local();
-      for (std::size_t k = range.begin(); k != range.end(); ++k)
-      {
-        const int p = samples[k];
-        if (active[p].load(std::memory_order_relaxed) || certified[p].load(std::memory_order_relaxed))
-        {
-          continue;
-        }
-        const std::uint32_t now = nextStamp(s);
-        s.Targets.clear();
-        sampleGrid.forEachWithin(S.Points[p], r, [&](int q) {
-          if (q != p)
-          {
-            s.Targets.push_back(q);
-            s.Target[q] = now;
-          }
-        });
-        std::size_t remaining = s.Targets.size();
-        if (remaining == 0)
-        {
-          continue;
-        }
-        dijkstra(s, p, l, [&](int u, double) { return !(s.Target[u] == now && --remaining == 0); });
-        if (remaining > 0)
-        {
-          // some Euclidean neighbour is farther than l along the surface: both are active
-          active[p].store(1, std::memory_order_relaxed);
-          for (int q : s.Targets)
-          {
-            if (s.Settled[q] != now)
-            {
-              active[q].store(1, std::memory_order_relaxed);
-            }
-          }
-        }
-      }
-      const std::size_t total = done.fetch_add(range.size()) + range.size();
-      if (progressUpdate(progress, 0.1 + 0.8 * static_cast<double>(total) / work))
-      {
-        cancelled.store(true);
-      }
-    });
-  if (cancelled.load() || progressCancelled(progress))
+  // candidate search within r, geodesic test against l, marking of the active samples
+  ActiveSampleDetection detection(S, graph, samples, options.Radius, options.GeodesicThreshold, progress);
+  if (!detection.run() || progressCancelled(progress))
   {
     result.Cancelled = true;
     result.Seconds = seconds(t0);
     return result;
   }
 
-  // g_A: multi-source Dijkstra from the active samples, up to the cutoff.
-  std::vector<HeapEntry> heap;
-  std::vector<char> settled(n, 0);
-  std::vector<double>& g = result.GeodesicToActive;
-  for (int p : samples)
-  {
-    if (active[p].load(std::memory_order_relaxed))
-    {
-      ++result.NumberOfActiveSamples;
-      g[p] = 0.0;
-      pushHeap(heap, 0.0, p);
-    }
-  }
-  while (!heap.empty())
-  {
-    const auto [d, u] = popHeap(heap);
-    if (settled[u] || d > g[u])
-    {
-      continue;
-    }
-    settled[u] = 1;
-    for (std::size_t e = graph.Start[u]; e < graph.Start[u + 1]; ++e)
-    {
-      const int v = graph.Neighbor[e];
-      const double nd = d + graph.Length[e];
-      if (!settled[v] && nd < g[v])
-      {
-        g[v] = nd;
-        pushHeap(heap, nd, v);
-      }
-    }
-  }
-  // A point is flagged active when it lies within half a spacing of an active sample (the
-  // resolution of the sampling).
+  // g_A, and the points flagged active: those within half a spacing of an active sample (the
+  // resolution of the sampling)
+  result.NumberOfActiveSamples = geodesicToActive(graph, samples, detection, result.Cutoff, result.GeodesicToActive);
   for (std::size_t i = 0; i < n; ++i)
   {
-    if (referenced[i] && g[i] <= separation)
+    if (referenced[i] && result.GeodesicToActive[i] <= separation)
     {
       result.Active[i] = 1;
       ++result.NumberOfActivePoints;

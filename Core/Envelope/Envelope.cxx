@@ -95,11 +95,7 @@ TriangleMesh outerBoundary(const TriangleMesh& surface, int& removed)
       for (int f : trianglesOf[o])
       {
         const Triangle& t = surface.Triangles[f];
-        const Vec3 a = surface.Points[t[0]] - p, b = surface.Points[t[1]] - p, c = surface.Points[t[2]] - p;
-        const double la = a.norm(), lb = b.norm(), lc = c.norm();
-        const double num = a.dot(b.cross(c));
-        const double den = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
-        total += 2.0 * std::atan2(num, den);
+        total += solidAngle(surface.Points[t[0]], surface.Points[t[1]], surface.Points[t[2]], p);
       }
       return total / (4.0 * M_PI);
     };

@@ -393,308 +393,341 @@ double triangleMIPSEnergy(const Vec3& a, const Vec3& b, const Vec3& c)
   return sum / (std::sqrt(3.0) * area2);
 }
 
-CageQualityResult evaluateCage(const TriangleMesh& inputMesh, const TriangleMesh& cageMesh,
-  const CageQualityOptions& options, Progress* progress)
+namespace
 {
-  const auto start = std::chrono::steady_clock::now();
-  CageQualityResult r;
-  auto lapStart = start;
-  auto lap = [&](int phase) {
-    const auto now = std::chrono::steady_clock::now();
-    r.PhaseSeconds[phase] += std::chrono::duration<double>(now - lapStart).count();
-    lapStart = now;
-  };
-  std::vector<std::string> reasons;
-  // the input's topology (closedness, genus) is needed only for the report: it runs beside
-  // everything else and is waited for at the end
-  tbb::task_group inputTopology;
-  auto finish = [&]() {
-    inputTopology.wait();
-    std::string msg;
-    for (const std::string& s : reasons)
+/// One evaluation by evaluateCage(): the meshes, what the phases hand on to each other and the
+/// result being filled. The phases run in the order of run(), each timed under its name
+/// (CageQualityPhase); any of them may end the evaluation early.
+class CageEvaluation
+{
+public:
+  CageEvaluation(const TriangleMesh& inputMesh, const TriangleMesh& cageMesh, const CageQualityOptions& options,
+    Progress* progress)
+    : InputMesh(inputMesh)
+    , CageMesh(cageMesh)
+    , Options(options)
+    , Report(progress)
+  {
+  }
+
+  CageQualityResult run()
+  {
+    this->Start = std::chrono::steady_clock::now();
+    // every phase returns false when the evaluation ends after it; a cancel ends it after any
+    const std::pair<CageQualityPhase, bool (CageEvaluation::*)()> phases[] = {
+      { CageQualityPhase::Topology, &CageEvaluation::checkTopologyAndShape },
+      { CageQualityPhase::SelfIntersections, &CageEvaluation::countSelfIntersectingPairs },
+      { CageQualityPhase::PointDistances, &CageEvaluation::measurePointDistances },
+      { CageQualityPhase::Clearance, &CageEvaluation::measureClearance },
+      { CageQualityPhase::InsideTest, &CageEvaluation::countInputVerticesOutside },
+      { CageQualityPhase::MeanDistance, &CageEvaluation::measureMeanDistance },
+      { CageQualityPhase::Hausdorff, &CageEvaluation::measureHausdorffDistances },
+    };
+    for (const auto& [phase, measure] : phases)
     {
-      msg += (msg.empty() ? "" : "; ") + s;
+      const auto begin = std::chrono::steady_clock::now();
+      const bool more = (this->*measure)();
+      this->R.PhaseSeconds[static_cast<int>(phase)] +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - begin).count();
+      if (!more || this->cancelled())
+      {
+        return this->finish();
+      }
     }
-    r.Message = msg;
-    r.Seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    return r;
-  };
-  auto cancelled = [&]() {
-    if (progressCancelled(progress))
+    this->R.Encloses = this->Reasons.empty() && this->R.SelfIntersections == 0 && this->R.InputIntersections == 0 &&
+      this->R.InputVerticesOutside == 0 && this->R.MinimumClearance > 0.0;
+    return this->finish();
+  }
+
+private:
+  /// Valid triangles of both meshes; the shape of every cage triangle; the defects, genus and
+  /// orientation of the cage (the input's topology runs beside all later phases); the two search
+  /// trees; the scale of the touching tolerance; the defects that rule out enclosure.
+  bool checkTopologyAndShape()
+  {
+    CageQualityResult& r = this->R;
+    r.InputInvalidTriangles = sanitize(this->InputMesh, this->Input, this->InputKept);
+    r.InvalidTriangles = sanitize(this->CageMesh, this->Cage, this->CageKept);
+    const std::size_t ncells = this->CageMesh.Triangles.size();
+    r.PointDistance.assign(this->CageMesh.Points.size(), kNaN);
+    r.CellDistance.assign(ncells, kNaN);
+    r.CellMinimumAngle.assign(ncells, kNaN);
+    r.CellMIPSEnergy.assign(ncells, kNaN);
+    const TriangleMesh &input = this->Input, &cage = this->Cage;
+
+    for (std::size_t i = 0; i < cage.Triangles.size(); ++i)
     {
+      const Triangle& t = cage.Triangles[i];
+      const Vec3 &a = cage.Points[t[0]], &b = cage.Points[t[1]], &c = cage.Points[t[2]];
+      r.CellMinimumAngle[this->CageKept[i]] = triangleMinimumAngle(a, b, c);
+      r.CellMIPSEnergy[this->CageKept[i]] = triangleMIPSEnergy(a, b, c);
+    }
+
+    progressStage(this->Report, "topology", 0.0, 0.1);
+    this->InputUsed = referencedMask(input);
+    r.InputVertices = std::count(this->InputUsed.begin(), this->InputUsed.end(), 1);
+    // the input's topology and the two search trees are independent: build them concurrently
+    MeshDefects dc;
+    if (!input.empty())
+    {
+      this->InputTopology.run([this]() {
+        const MeshDefects di = checkTriangleMesh(this->Input);
+        this->R.InputClosedManifold = di.BoundaryEdges == 0 && di.NonManifoldEdges == 0 && di.NonManifoldVertices == 0;
+        this->R.InputGenus = !this->R.InputClosedManifold ? -1 : di.usable() ? di.Genus : genus(this->Input);
+      });
+    }
+    tbb::parallel_invoke(
+      [&]() {
+        if (!input.empty() && !cage.empty())
+        {
+          this->InputTree.build(input);
+        }
+      },
+      [&]() {
+        if (!cage.empty())
+        {
+          dc = checkTriangleMesh(cage);
+          this->CageTree.build(cage);
+        }
+      });
+    if (!cage.empty())
+    {
+      r.BoundaryEdges = dc.BoundaryEdges;
+      r.NonManifoldEdges = dc.NonManifoldEdges;
+      r.NonManifoldVertices = dc.NonManifoldVertices;
+      r.DegenerateTriangles = dc.DegenerateTriangles;
+      r.InconsistentEdges = dc.InconsistentEdges;
+      r.CageComponents = dc.Components;
+      r.CageClosedManifold = dc.BoundaryEdges == 0 && dc.NonManifoldEdges == 0 && dc.NonManifoldVertices == 0;
+      r.CageGenus = !r.CageClosedManifold ? -1 : dc.usable() ? dc.Genus : genus(cage);
+      r.CageInwardOriented = r.CageClosedManifold && r.InconsistentEdges == 0 && signedVolume(cage) < 0;
+    }
+
+    // the scale: the input's bounding box, or the cage's when there is no input
+    const TriangleMesh& scaleMesh = input.empty() ? cage : input;
+    if (!scaleMesh.empty())
+    {
+      const auto box = bounds(scaleMesh);
+      r.Diagonal = (box[1] - box[0]).norm();
+    }
+    double scale = r.Diagonal;
+    if (!cage.empty())
+    {
+      const auto box = bounds(cage);
+      scale = std::max(scale, (box[1] - box[0]).norm());
+    }
+    this->Touching = this->Options.TouchingTolerance * scale;
+
+    std::vector<std::string>& reasons = this->Reasons;
+    if (cage.empty())
+    {
+      reasons.push_back(this->CageMesh.Triangles.empty() ? "the cage has no triangles" : "the cage has no valid triangles");
+    }
+    if (input.empty())
+    {
+      reasons.push_back(
+        this->InputMesh.Triangles.empty() ? "the input mesh has no triangles" : "the input mesh has no valid triangles");
+    }
+    if (r.InvalidTriangles > 0)
+    {
+      reasons.push_back(
+        "the cage has " + std::to_string(r.InvalidTriangles) + " triangles with invalid point ids or non-finite points");
+    }
+    if (!cage.empty() && !r.CageClosedManifold)
+    {
+      reasons.push_back("the cage is not a closed 2-manifold (" + std::to_string(r.BoundaryEdges) + " boundary edges, " +
+        std::to_string(r.NonManifoldEdges) + " non-manifold edges, " + std::to_string(r.NonManifoldVertices) +
+        " non-manifold vertices)");
+    }
+    if (r.InconsistentEdges > 0)
+    {
+      reasons.push_back("the cage is inconsistently oriented (" + std::to_string(r.InconsistentEdges) + " edges)");
+    }
+    if (r.DegenerateTriangles > 0)
+    {
+      reasons.push_back("the cage has " + std::to_string(r.DegenerateTriangles) + " degenerate triangles");
+    }
+    this->InsideDefined = !cage.empty() && r.InvalidTriangles == 0 && r.CageClosedManifold &&
+      r.InconsistentEdges == 0 && r.DegenerateTriangles == 0;
+    return true;
+  }
+
+  /// Intersecting or touching pairs of non-adjacent cage triangles (degenerate triangles count
+  /// once each, as CGAL reports them). Ends the evaluation when either mesh is empty.
+  bool countSelfIntersectingPairs()
+  {
+    CageQualityResult& r = this->R;
+    progressStage(this->Report, "self-intersections", 0.1, 0.2);
+    if (!this->Cage.empty())
+    {
+      r.SelfIntersections = countSelfIntersections(this->Cage, this->Report, this->Touching) + r.DegenerateTriangles;
+      if (r.SelfIntersections > 0)
+      {
+        this->Reasons.push_back("the cage intersects itself (" + std::to_string(r.SelfIntersections) + " triangle pairs)");
+      }
+    }
+    if (this->Cage.empty() || this->Input.empty())
+    {
+      r.InputVerticesOutside = r.InputVertices;
       r.Encloses = false;
-      reasons.assign(1, "cancelled");
-      return true;
+      return false;
     }
-    return false;
-  };
-
-  TriangleMesh input, cage;
-  std::vector<int> inputKept, cageKept;
-  r.InputInvalidTriangles = sanitize(inputMesh, input, inputKept);
-  r.InvalidTriangles = sanitize(cageMesh, cage, cageKept);
-  const std::size_t ncells = cageMesh.Triangles.size();
-  r.PointDistance.assign(cageMesh.Points.size(), kNaN);
-  r.CellDistance.assign(ncells, kNaN);
-  r.CellMinimumAngle.assign(ncells, kNaN);
-  r.CellMIPSEnergy.assign(ncells, kNaN);
-
-  // --- shape of the cage triangles ---
-  for (std::size_t i = 0; i < cage.Triangles.size(); ++i)
-  {
-    const Triangle& t = cage.Triangles[i];
-    const Vec3 &a = cage.Points[t[0]], &b = cage.Points[t[1]], &c = cage.Points[t[2]];
-    r.CellMinimumAngle[cageKept[i]] = triangleMinimumAngle(a, b, c);
-    r.CellMIPSEnergy[cageKept[i]] = triangleMIPSEnergy(a, b, c);
+    return true;
   }
 
-  // --- topology ---
-  progressStage(progress, "topology", 0.0, 0.1);
-  const std::vector<char> inputUsed = referencedMask(input);
-  r.InputVertices = std::count(inputUsed.begin(), inputUsed.end(), 1);
-  // the input's topology and the two search trees are independent: build them concurrently
-  TriangleTree inputTree, cageTree;
-  MeshDefects dc;
-  if (!input.empty())
+  /// Exact distance of every cage point to the input and of every input point to the cage (with
+  /// the closest triangles, for the Hausdorff bounds); their smallest value bounds the clearance.
+  bool measurePointDistances()
   {
-    inputTopology.run([&]() {
-      const MeshDefects di = checkTriangleMesh(input);
-      r.InputClosedManifold = di.BoundaryEdges == 0 && di.NonManifoldEdges == 0 && di.NonManifoldVertices == 0;
-      r.InputGenus = !r.InputClosedManifold ? -1 : di.usable() ? di.Genus : genus(input);
-    });
-  }
-  tbb::parallel_invoke(
-    [&]() {
-      if (!input.empty() && !cage.empty())
-      {
-        inputTree.build(input);
-      }
-    },
-    [&]() {
-      if (!cage.empty())
-      {
-        dc = checkTriangleMesh(cage);
-        cageTree.build(cage);
-      }
-    });
-  if (!cage.empty())
-  {
-    r.BoundaryEdges = dc.BoundaryEdges;
-    r.NonManifoldEdges = dc.NonManifoldEdges;
-    r.NonManifoldVertices = dc.NonManifoldVertices;
-    r.DegenerateTriangles = dc.DegenerateTriangles;
-    r.InconsistentEdges = dc.InconsistentEdges;
-    r.CageComponents = dc.Components;
-    r.CageClosedManifold = dc.BoundaryEdges == 0 && dc.NonManifoldEdges == 0 && dc.NonManifoldVertices == 0;
-    r.CageGenus = !r.CageClosedManifold ? -1 : dc.usable() ? dc.Genus : genus(cage);
-    r.CageInwardOriented = r.CageClosedManifold && r.InconsistentEdges == 0 && signedVolume(cage) < 0;
-  }
-
-  // the scale: the input's bounding box, or the cage's when there is no input
-  const TriangleMesh& scaleMesh = input.empty() ? cage : input;
-  if (!scaleMesh.empty())
-  {
-    const auto box = bounds(scaleMesh);
-    r.Diagonal = (box[1] - box[0]).norm();
-  }
-  double scale = r.Diagonal;
-  if (!cage.empty())
-  {
-    const auto box = bounds(cage);
-    scale = std::max(scale, (box[1] - box[0]).norm());
-  }
-  const double touching = options.TouchingTolerance * scale;
-
-  if (cage.empty())
-  {
-    reasons.push_back(cageMesh.Triangles.empty() ? "the cage has no triangles" : "the cage has no valid triangles");
-  }
-  if (input.empty())
-  {
-    reasons.push_back(inputMesh.Triangles.empty() ? "the input mesh has no triangles" : "the input mesh has no valid triangles");
-  }
-  if (r.InvalidTriangles > 0)
-  {
-    reasons.push_back("the cage has " + std::to_string(r.InvalidTriangles) + " triangles with invalid point ids or non-finite points");
-  }
-  if (!cage.empty() && !r.CageClosedManifold)
-  {
-    reasons.push_back("the cage is not a closed 2-manifold (" + std::to_string(r.BoundaryEdges) + " boundary edges, " +
-      std::to_string(r.NonManifoldEdges) + " non-manifold edges, " + std::to_string(r.NonManifoldVertices) +
-      " non-manifold vertices)");
-  }
-  if (r.InconsistentEdges > 0)
-  {
-    reasons.push_back("the cage is inconsistently oriented (" + std::to_string(r.InconsistentEdges) + " edges)");
-  }
-  if (r.DegenerateTriangles > 0)
-  {
-    reasons.push_back("the cage has " + std::to_string(r.DegenerateTriangles) + " degenerate triangles");
-  }
-  const bool insideDefined = !cage.empty() && r.InvalidTriangles == 0 && r.CageClosedManifold &&
-    r.InconsistentEdges == 0 && r.DegenerateTriangles == 0;
-  if (cancelled())
-  {
-    return finish();
-  }
-
-  lap(0);
-  // --- self-intersections (degenerate triangles count once each, as CGAL reports them) ---
-  progressStage(progress, "self-intersections", 0.1, 0.2);
-  if (!cage.empty())
-  {
-    r.SelfIntersections = countSelfIntersections(cage, progress, touching) + r.DegenerateTriangles;
-    if (r.SelfIntersections > 0)
-    {
-      reasons.push_back("the cage intersects itself (" + std::to_string(r.SelfIntersections) + " triangle pairs)");
-    }
-  }
-  if (cage.empty() || input.empty())
-  {
-    r.InputVerticesOutside = r.InputVertices;
-    r.Encloses = false;
-    return finish();
-  }
-  if (cancelled())
-  {
-    return finish();
-  }
-
-  lap(1);
-  // --- point distances both ways ---
-  progressStage(progress, "distances", 0.2, 0.4);
-  const std::vector<char> cageUsed = referencedMask(cage);
-  std::vector<int> cageNear, inputNear;
-  const std::vector<double> cageDistance = pointDistances(cage, cageUsed, inputTree, cageNear);
-  const std::vector<double> inputDistance = pointDistances(input, inputUsed, cageTree, inputNear);
-  // every finite cage point gets its distance (unreferenced ones too: they are displayed)
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cageMesh.Points.size(), 512), [&](const tbb::blocked_range<std::size_t>& rg) {
-    for (std::size_t i = rg.begin(); i != rg.end(); ++i)
-    {
-      if (cageUsed[i])
-      {
-        r.PointDistance[i] = cageDistance[i];
-      }
-      else if (cageMesh.Points[i].allFinite())
-      {
-        r.PointDistance[i] = inputTree.distance(cageMesh.Points[i]);
-      }
-    }
-  });
-  double upper = kInf, sum = 0.0;
-  long long counted = 0;
-  for (std::size_t i = 0; i < cageDistance.size(); ++i)
-  {
-    if (cageUsed[i])
-    {
-      upper = std::min(upper, cageDistance[i]);
-      r.MaximumPointDistance = std::max(r.MaximumPointDistance, cageDistance[i]);
-      sum += cageDistance[i];
-      ++counted;
-    }
-  }
-  r.MeanPointDistance = counted ? sum / static_cast<double>(counted) : 0.0;
-  for (std::size_t i = 0; i < inputDistance.size(); ++i)
-  {
-    if (inputUsed[i])
-    {
-      upper = std::min(upper, inputDistance[i]);
-    }
-  }
-  if (cancelled())
-  {
-    return finish();
-  }
-
-  lap(2);
-  // --- exact minimum clearance: cage triangles in increasing order of a Lipschitz lower bound,
-  // each measured exactly against the input only below the best value so far ---
-  progressStage(progress, "clearance", 0.4, 0.6);
-  const std::size_t nf = cage.Triangles.size();
-  std::vector<double> lowerBound(nf);
-  std::vector<int> order(nf);
-  for (std::size_t f = 0; f < nf; ++f)
-  {
-    const Triangle& t = cage.Triangles[f];
-    double lb = -kInf;
-    for (int i = 0; i < 3; ++i)
-    {
-      const Vec3& p = cage.Points[t[i]];
-      const double reach = std::max((cage.Points[t[(i + 1) % 3]] - p).norm(), (cage.Points[t[(i + 2) % 3]] - p).norm());
-      lb = std::max(lb, cageDistance[t[i]] - reach);
-    }
-    lowerBound[f] = lb;
-    order[f] = static_cast<int>(f);
-  }
-  std::sort(order.begin(), order.end(), [&](int a, int b) { return lowerBound[a] < lowerBound[b] || (lowerBound[a] == lowerBound[b] && a < b); });
-  std::atomic<double> best{ upper };
-  const std::size_t chunk = 256;
-  for (std::size_t b = 0; b < nf; b += chunk)
-  {
-    if (lowerBound[order[b]] >= best.load() || cancelled())
-    {
-      break;
-    }
-    const std::size_t e = std::min(nf, b + chunk);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(b, e, 4), [&](const tbb::blocked_range<std::size_t>& rg) {
-      for (std::size_t k = rg.begin(); k != rg.end(); ++k)
-      {
-        const int f = order[k];
-        double current = best.load();
-        if (lowerBound[f] >= current)
+    CageQualityResult& r = this->R;
+    progressStage(this->Report, "distances", 0.2, 0.4);
+    this->CageUsed = referencedMask(this->Cage);
+    this->CageDistance = pointDistances(this->Cage, this->CageUsed, this->InputTree, this->CageNear);
+    this->InputDistance = pointDistances(this->Input, this->InputUsed, this->CageTree, this->InputNear);
+    // every finite cage point gets its distance (unreferenced ones too: they are displayed)
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, this->CageMesh.Points.size(), 512),
+      [&](const tbb::blocked_range<std::size_t>& rg) {
+        for (std::size_t i = rg.begin(); i != rg.end(); ++i)
         {
-          continue;
+          if (this->CageUsed[i])
+          {
+            r.PointDistance[i] = this->CageDistance[i];
+          }
+          else if (this->CageMesh.Points[i].allFinite())
+          {
+            r.PointDistance[i] = this->InputTree.distance(this->CageMesh.Points[i]);
+          }
         }
-        const Triangle& t = cage.Triangles[f];
-        const Vec3 tri[3] = { cage.Points[t[0]], cage.Points[t[1]], cage.Points[t[2]] };
-        const double d = inputTree.triangleDistance(tri, current);
-        while (d < current && !best.compare_exchange_weak(current, d))
-        {
-        }
+      });
+    double upper = kInf, sum = 0.0;
+    long long counted = 0;
+    for (std::size_t i = 0; i < this->CageDistance.size(); ++i)
+    {
+      if (this->CageUsed[i])
+      {
+        upper = std::min(upper, this->CageDistance[i]);
+        r.MaximumPointDistance = std::max(r.MaximumPointDistance, this->CageDistance[i]);
+        sum += this->CageDistance[i];
+        ++counted;
       }
-    });
+    }
+    r.MeanPointDistance = counted ? sum / static_cast<double>(counted) : 0.0;
+    for (std::size_t i = 0; i < this->InputDistance.size(); ++i)
+    {
+      if (this->InputUsed[i])
+      {
+        upper = std::min(upper, this->InputDistance[i]);
+      }
+    }
+    this->ClearanceUpperBound = upper;
+    return true;
   }
-  if (cancelled())
+
+  /// Exact minimum clearance: cage triangles in increasing order of a Lipschitz lower bound, each
+  /// measured exactly against the input only below the best value so far; when the surfaces
+  /// touch, the intersecting or touching cage/input pairs are counted.
+  bool measureClearance()
   {
-    return finish();
-  }
-  r.MinimumClearance = best.load() <= touching ? 0.0 : best.load();
-  if (r.MinimumClearance == 0.0)
-  {
-    // count the intersecting or touching pairs (only triangles that can reach the input)
-    r.InputIntersections = tbb::parallel_reduce(
-      tbb::blocked_range<std::size_t>(0, nf, 16), 0LL,
-      [&](const tbb::blocked_range<std::size_t>& rg, long long count) {
-        for (std::size_t f = rg.begin(); f != rg.end(); ++f)
+    CageQualityResult& r = this->R;
+    const TriangleMesh& cage = this->Cage;
+    const TriangleTree& inputTree = this->InputTree;
+    progressStage(this->Report, "clearance", 0.4, 0.6);
+    const std::size_t nf = cage.Triangles.size();
+    std::vector<double>& lowerBound = this->CellLowerBound;
+    lowerBound.resize(nf);
+    std::vector<int> order(nf);
+    for (std::size_t f = 0; f < nf; ++f)
+    {
+      const Triangle& t = cage.Triangles[f];
+      double lb = -kInf;
+      for (int i = 0; i < 3; ++i)
+      {
+        const Vec3& p = cage.Points[t[i]];
+        const double reach =
+          std::max((cage.Points[t[(i + 1) % 3]] - p).norm(), (cage.Points[t[(i + 2) % 3]] - p).norm());
+        lb = std::max(lb, this->CageDistance[t[i]] - reach);
+      }
+      lowerBound[f] = lb;
+      order[f] = static_cast<int>(f);
+    }
+    std::sort(order.begin(), order.end(),
+      [&](int a, int b) { return lowerBound[a] < lowerBound[b] || (lowerBound[a] == lowerBound[b] && a < b); });
+    std::atomic<double> best{ this->ClearanceUpperBound };
+    const std::size_t chunk = 256;
+    for (std::size_t b = 0; b < nf; b += chunk)
+    {
+      if (lowerBound[order[b]] >= best.load() || this->cancelled())
+      {
+        break;
+      }
+      const std::size_t e = std::min(nf, b + chunk);
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(b, e, 4), [&](const tbb::blocked_range<std::size_t>& rg) {
+        for (std::size_t k = rg.begin(); k != rg.end(); ++k)
         {
-          if (lowerBound[f] > touching)
+          const int f = order[k];
+          double current = best.load();
+          if (lowerBound[f] >= current)
           {
             continue;
           }
           const Triangle& t = cage.Triangles[f];
           const Vec3 tri[3] = { cage.Points[t[0]], cage.Points[t[1]], cage.Points[t[2]] };
-          count += inputTree.countWithin(tri, touching);
+          const double d = inputTree.triangleDistance(tri, current);
+          while (d < current && !best.compare_exchange_weak(current, d))
+          {
+          }
         }
-        return count;
-      },
-      [](long long a, long long b) { return a + b; });
-    reasons.push_back("the cage intersects or touches the input (" + std::to_string(r.InputIntersections) +
-      " cage/input triangle pairs)");
+      });
+    }
+    if (this->cancelled())
+    {
+      return false;
+    }
+    const double touching = this->Touching;
+    r.MinimumClearance = best.load() <= touching ? 0.0 : best.load();
+    if (r.MinimumClearance == 0.0)
+    {
+      // count the intersecting or touching pairs (only triangles that can reach the input)
+      r.InputIntersections = tbb::parallel_reduce(
+        tbb::blocked_range<std::size_t>(0, nf, 16), 0LL,
+        [&](const tbb::blocked_range<std::size_t>& rg, long long count) {
+          for (std::size_t f = rg.begin(); f != rg.end(); ++f)
+          {
+            if (lowerBound[f] > touching)
+            {
+              continue;
+            }
+            const Triangle& t = cage.Triangles[f];
+            const Vec3 tri[3] = { cage.Points[t[0]], cage.Points[t[1]], cage.Points[t[2]] };
+            count += inputTree.countWithin(tri, touching);
+          }
+          return count;
+        },
+        [](long long a, long long b) { return a + b; });
+      this->Reasons.push_back("the cage intersects or touches the input (" + std::to_string(r.InputIntersections) +
+        " cage/input triangle pairs)");
+    }
+    return true;
   }
 
-  lap(3);
-  // --- input vertices inside: the winding number is constant along every input edge that cannot
-  // reach the cage (d(u) + d(v) > |u - v|, the distance being 1-Lipschitz), so it is evaluated
-  // once per group of vertices connected by such edges, at the vertex farthest from the cage ---
-  progressStage(progress, "inside test", 0.6, 0.7);
-  if (!insideDefined)
+  /// Input vertices not strictly inside the cage. The winding number is constant along every
+  /// input edge that cannot reach the cage (d(u) + d(v) > |u - v|, the distance being
+  /// 1-Lipschitz), so it is evaluated once per group of vertices connected by such edges, at the
+  /// vertex farthest from the cage.
+  bool countInputVerticesOutside()
   {
-    r.InputVerticesOutside = r.InputVertices;
-    reasons.push_back("inside/outside is undefined for this cage: all " + std::to_string(r.InputVertices) +
-      " input vertices count as outside");
-  }
-  else
-  {
+    CageQualityResult& r = this->R;
+    const TriangleMesh& input = this->Input;
+    const std::vector<double>& inputDistance = this->InputDistance;
+    const double touching = this->Touching;
+    progressStage(this->Report, "inside test", 0.6, 0.7);
+    if (!this->InsideDefined)
+    {
+      r.InputVerticesOutside = r.InputVertices;
+      this->Reasons.push_back("inside/outside is undefined for this cage: all " + std::to_string(r.InputVertices) +
+        " input vertices count as outside");
+      return true;
+    }
     UnionFind groups(input.Points.size());
     for (const Triangle& t : input.Triangles)
     {
@@ -712,7 +745,7 @@ CageQualityResult evaluateCage(const TriangleMesh& inputMesh, const TriangleMesh
     std::vector<int> roots;
     for (std::size_t i = 0; i < input.Points.size(); ++i)
     {
-      if (!inputUsed[i])
+      if (!this->InputUsed[i])
       {
         continue;
       }
@@ -736,107 +769,169 @@ CageQualityResult evaluateCage(const TriangleMesh& inputMesh, const TriangleMesh
         {
           continue; // on the cage: not strictly inside
         }
-        const long long w = std::llround(std::abs(windingNumber(cage, input.Points[rep])));
+        const long long w = std::llround(std::abs(windingNumber(this->Cage, input.Points[rep])));
         inside[roots[k]] = (w % 2) == 1;
       }
     });
     for (std::size_t i = 0; i < input.Points.size(); ++i)
     {
-      if (inputUsed[i] && !(inside[groups.find(static_cast<int>(i))] && inputDistance[i] > touching))
+      if (this->InputUsed[i] && !(inside[groups.find(static_cast<int>(i))] && inputDistance[i] > touching))
       {
         ++r.InputVerticesOutside;
       }
     }
     if (r.InputVerticesOutside > 0)
     {
-      reasons.push_back(std::to_string(r.InputVerticesOutside) + " of " + std::to_string(r.InputVertices) +
+      this->Reasons.push_back(std::to_string(r.InputVerticesOutside) + " of " + std::to_string(r.InputVertices) +
         " input vertices are not strictly inside the cage");
     }
-  }
-  if (cancelled())
-  {
-    return finish();
+    return true;
   }
 
-  lap(4);
-  // --- mean distance over the cage (midpoint rule on 4^level sub-triangles per triangle, the level
-  // chosen per triangle from its size) ---
-  progressStage(progress, "mean distance", 0.7, 0.8);
-  const double spacing = std::max(options.MeanDistanceSpacing, 1e-6) * r.Diagonal;
-  const int minimumLevel = std::clamp(options.MinimumMeanDistanceLevel, 0, 6);
-  std::vector<double> cellArea(nf), cellMean(nf), cellMax(nf);
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 4), [&](const tbb::blocked_range<std::size_t>& rg) {
-    for (std::size_t f = rg.begin(); f != rg.end(); ++f)
-    {
-      const Triangle& t = cage.Triangles[f];
-      const Vec3 &a = cage.Points[t[0]], &b = cage.Points[t[1]], &c = cage.Points[t[2]];
-      const double edge = std::max({ (b - a).norm(), (c - b).norm(), (a - c).norm() });
-      int level = minimumLevel;
-      while (level < 6 && edge > spacing * static_cast<double>(1 << level))
+  /// Area-weighted mean distance over the cage (midpoint rule on 4^level sub-triangles per
+  /// triangle, the level chosen per triangle from its size); the largest sample of each triangle
+  /// starts its CellDistance and the Hausdorff search.
+  bool measureMeanDistance()
+  {
+    CageQualityResult& r = this->R;
+    const TriangleMesh& cage = this->Cage;
+    progressStage(this->Report, "mean distance", 0.7, 0.8);
+    const double spacing = std::max(this->Options.MeanDistanceSpacing, 1e-6) * r.Diagonal;
+    const int minimumLevel = std::clamp(this->Options.MinimumMeanDistanceLevel, 0, 6);
+    const std::size_t nf = cage.Triangles.size();
+    std::vector<double> cellArea(nf), cellMean(nf);
+    std::vector<double>& cellMax = this->CellMaximum;
+    cellMax.assign(nf, 0.0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 4), [&](const tbb::blocked_range<std::size_t>& rg) {
+      for (std::size_t f = rg.begin(); f != rg.end(); ++f)
       {
-        ++level;
-      }
-      const int n = 1 << level;
-      double m = std::max({ cageDistance[t[0]], cageDistance[t[1]], cageDistance[t[2]] });
-      double s = 0.0;
-      auto at = [&](double u, double v) {
-        const double d = inputTree.distance(a + (b - a) * (u / n) + (c - a) * (v / n));
-        m = std::max(m, d);
-        s += d;
-      };
-      for (int i = 0; i < n; ++i)
-      {
-        for (int j = 0; i + j < n; ++j)
+        const Triangle& t = cage.Triangles[f];
+        const Vec3 &a = cage.Points[t[0]], &b = cage.Points[t[1]], &c = cage.Points[t[2]];
+        const double edge = std::max({ (b - a).norm(), (c - b).norm(), (a - c).norm() });
+        int level = minimumLevel;
+        while (level < 6 && edge > spacing * static_cast<double>(1 << level))
         {
-          at(i + 1.0 / 3.0, j + 1.0 / 3.0);
-          if (i + j < n - 1)
+          ++level;
+        }
+        const int n = 1 << level;
+        double m = std::max({ this->CageDistance[t[0]], this->CageDistance[t[1]], this->CageDistance[t[2]] });
+        double s = 0.0;
+        auto at = [&](double u, double v) {
+          const double d = this->InputTree.distance(a + (b - a) * (u / n) + (c - a) * (v / n));
+          m = std::max(m, d);
+          s += d;
+        };
+        for (int i = 0; i < n; ++i)
+        {
+          for (int j = 0; i + j < n; ++j)
           {
-            at(i + 2.0 / 3.0, j + 2.0 / 3.0);
+            at(i + 1.0 / 3.0, j + 1.0 / 3.0);
+            if (i + j < n - 1)
+            {
+              at(i + 2.0 / 3.0, j + 2.0 / 3.0);
+            }
           }
         }
+        cellArea[f] = 0.5 * (b - a).cross(c - a).norm();
+        cellMean[f] = s / static_cast<double>(n * n);
+        cellMax[f] = m;
       }
-      cellArea[f] = 0.5 * (b - a).cross(c - a).norm();
-      cellMean[f] = s / static_cast<double>(n * n);
-      cellMax[f] = m;
+    });
+    double area = 0.0, weighted = 0.0, sampledMax = 0.0;
+    for (std::size_t f = 0; f < nf; ++f)
+    {
+      area += cellArea[f];
+      weighted += cellArea[f] * cellMean[f];
+      sampledMax = std::max(sampledMax, cellMax[f]);
     }
-  });
-  double area = 0.0, weighted = 0.0, sampledMax = 0.0;
-  for (std::size_t f = 0; f < nf; ++f)
-  {
-    area += cellArea[f];
-    weighted += cellArea[f] * cellMean[f];
-    sampledMax = std::max(sampledMax, cellMax[f]);
-  }
-  r.MeanDistanceCageToInput = area > 0 ? weighted / area : r.MeanPointDistance;
-  if (cancelled())
-  {
-    return finish();
+    this->SampledMaximum = sampledMax;
+    r.MeanDistanceCageToInput = area > 0 ? weighted / area : r.MeanPointDistance;
+    return true;
   }
 
-  lap(5);
-  // --- Hausdorff distances (branch and bound) ---
-  progressStage(progress, "Hausdorff cage to input", 0.8, 0.9);
-  const double tol = options.HausdorffTolerance * r.Diagonal;
-  const HausdorffBounds hc = hausdorff(cage, cageDistance, cageNear, Target{ inputTree, input }, sampledMax, tol, options.HausdorffBudget, &cellMax, progress);
-  r.HausdorffCageToInput = hc.Value;
-  r.HausdorffCageToInputBound = hc.Bound;
-  for (std::size_t f = 0; f < nf; ++f)
+  /// Hausdorff distances both ways by branch and bound, with the certified bounds reached; the
+  /// cage-to-input search also completes CellDistance.
+  bool measureHausdorffDistances()
   {
-    r.CellDistance[cageKept[f]] = cellMax[f];
-  }
-  progressStage(progress, "Hausdorff input to cage", 0.9, 1.0);
-  const HausdorffBounds hi = hausdorff(input, inputDistance, inputNear, Target{ cageTree, cage }, 0.0, tol, options.HausdorffBudget, nullptr, progress);
-  r.HausdorffInputToCage = hi.Value;
-  r.HausdorffInputToCageBound = hi.Bound;
-  if (cancelled())
-  {
-    return finish();
+    CageQualityResult& r = this->R;
+    const double tol = this->Options.HausdorffTolerance * r.Diagonal;
+    progressStage(this->Report, "Hausdorff cage to input", 0.8, 0.9);
+    const HausdorffBounds hc = hausdorff(this->Cage, this->CageDistance, this->CageNear,
+      Target{ this->InputTree, this->Input }, this->SampledMaximum, tol, this->Options.HausdorffBudget,
+      &this->CellMaximum, this->Report);
+    r.HausdorffCageToInput = hc.Value;
+    r.HausdorffCageToInputBound = hc.Bound;
+    for (std::size_t f = 0; f < this->CellMaximum.size(); ++f)
+    {
+      r.CellDistance[this->CageKept[f]] = this->CellMaximum[f];
+    }
+    progressStage(this->Report, "Hausdorff input to cage", 0.9, 1.0);
+    const HausdorffBounds hi = hausdorff(this->Input, this->InputDistance, this->InputNear,
+      Target{ this->CageTree, this->Cage }, 0.0, tol, this->Options.HausdorffBudget, nullptr, this->Report);
+    r.HausdorffInputToCage = hi.Value;
+    r.HausdorffInputToCageBound = hi.Bound;
+    return true;
   }
 
-  lap(6);
-  r.Encloses = reasons.empty() && r.SelfIntersections == 0 && r.InputIntersections == 0 && r.InputVerticesOutside == 0 &&
-    r.MinimumClearance > 0.0;
-  return finish();
+  bool cancelled()
+  {
+    if (progressCancelled(this->Report))
+    {
+      this->R.Encloses = false;
+      this->Reasons.assign(1, "cancelled");
+      return true;
+    }
+    return false;
+  }
+
+  CageQualityResult finish()
+  {
+    this->InputTopology.wait();
+    std::string msg;
+    for (const std::string& s : this->Reasons)
+    {
+      msg += (msg.empty() ? "" : "; ") + s;
+    }
+    this->R.Message = msg;
+    this->R.Seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - this->Start).count();
+    return std::move(this->R);
+  }
+
+  const TriangleMesh& InputMesh;
+  const TriangleMesh& CageMesh;
+  const CageQualityOptions& Options;
+  Progress* Report;
+  std::chrono::steady_clock::time_point Start;
+  CageQualityResult R;
+  std::vector<std::string> Reasons; ///< why the cage does not enclose, in the order found
+  /// the input's topology is needed only for the report: it runs beside all other phases and is
+  /// waited for at the end
+  tbb::task_group InputTopology;
+
+  // checkTopologyAndShape
+  TriangleMesh Input, Cage;          ///< the valid triangles (points copied as they are)
+  std::vector<int> InputKept, CageKept; ///< original index of each valid triangle
+  std::vector<char> InputUsed;       ///< input points referenced by a valid triangle
+  TriangleTree InputTree, CageTree;
+  double Touching = 0.0;             ///< distances up to this count as touching
+  bool InsideDefined = false;        ///< the cage is closed, consistently oriented, not degenerate
+  // measurePointDistances
+  std::vector<char> CageUsed;
+  std::vector<double> CageDistance, InputDistance; ///< per referenced point, to the other surface
+  std::vector<int> CageNear, InputNear;            ///< the closest triangle of the other surface
+  double ClearanceUpperBound = kInf;
+  // measureClearance
+  std::vector<double> CellLowerBound; ///< per valid cage triangle, of its distance to the input
+  // measureMeanDistance
+  std::vector<double> CellMaximum;    ///< per valid cage triangle, the largest distance sampled
+  double SampledMaximum = 0.0;
+};
+} // namespace
+
+CageQualityResult evaluateCage(const TriangleMesh& inputMesh, const TriangleMesh& cageMesh,
+  const CageQualityOptions& options, Progress* progress)
+{
+  return CageEvaluation(inputMesh, cageMesh, options, progress).run();
 }
 
 } // namespace sdfcage

@@ -38,6 +38,20 @@ struct CageQualityOptions
   int MinimumMeanDistanceLevel = 2;
 };
 
+/// The phases of evaluateCage(), in the order they run (an evaluation may end after any of them:
+/// empty meshes after SelfIntersections, a cancel after any).
+enum class CageQualityPhase
+{
+  Topology,          ///< valid triangles, triangle shapes, cage defects and genus, the search trees
+                     ///< (the input's topology runs beside all phases)
+  SelfIntersections, ///< intersecting or touching non-adjacent cage triangle pairs
+  PointDistances,    ///< exact distance of every point to the other surface, both ways
+  Clearance,         ///< exact minimum distance between the surfaces (and touching pairs)
+  InsideTest,        ///< input vertices strictly inside the cage (winding number)
+  MeanDistance,      ///< area-weighted mean distance over the cage (quadrature)
+  Hausdorff          ///< Hausdorff distances both ways (branch and bound)
+};
+
 /// Everything evaluateCage() measured. Lengths in the meshes' own units; "Relative" values are
 /// divided by the input's bounding-box diagonal. Counts refer to the cage unless named otherwise.
 ///
@@ -101,12 +115,11 @@ struct CageQualityResult
   long long InputInvalidTriangles = 0;
 
   double Seconds = 0.0;
-  /// Wall time of the phases: cage topology, shape and the search trees (the input's topology
-  /// runs beside all phases), self-intersections, point distances both ways, exact clearance
-  /// (and intersecting pairs), inside test, mean distance, Hausdorff.
+  /// Wall time of each phase, indexed by CageQualityPhase (phaseSeconds()); named by PhaseNames.
   double PhaseSeconds[7] = { 0, 0, 0, 0, 0, 0, 0 };
   static constexpr const char* PhaseNames[7] = { "topology", "self-intersections", "point distances",
     "clearance", "inside test", "mean distance", "Hausdorff" };
+  double phaseSeconds(CageQualityPhase phase) const { return PhaseSeconds[static_cast<int>(phase)]; }
 };
 
 /// Judges `cage` against `input` (same coordinates). Never throws on bad meshes: an empty or

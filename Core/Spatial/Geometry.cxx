@@ -229,15 +229,11 @@ bool trianglesConflict(const int ia[3], const Vec3 pa[3], const int ib[3], const
 
 double windingNumber(const TriangleMesh& mesh, const Vec3& p)
 {
-  // Sum of signed solid angles (Van Oosterom & Strackee), divided by 4 pi.
+  // Sum of signed solid angles, divided by 4 pi.
   double total = 0.0;
   for (const Triangle& t : mesh.Triangles)
   {
-    const Vec3 a = mesh.Points[t[0]] - p, b = mesh.Points[t[1]] - p, c = mesh.Points[t[2]] - p;
-    const double la = a.norm(), lb = b.norm(), lc = c.norm();
-    const double num = a.dot(b.cross(c));
-    const double den = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
-    total += 2.0 * std::atan2(num, den);
+    total += solidAngle(mesh.Points[t[0]], mesh.Points[t[1]], mesh.Points[t[2]], p);
   }
   return total / (4.0 * M_PI);
 }

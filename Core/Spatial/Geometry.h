@@ -30,6 +30,20 @@ bool meetBeyondSharedVertex(const Vec3& a, const Vec3& b, const Vec3& c, const V
 bool trianglesConflict(const int ia[3], const Vec3 pa[3], const int ib[3], const Vec3 pb[3],
   double separation, double foldCosine);
 
+/// Signed solid angle of triangle (a, b, c) seen from p (Van Oosterom & Strackee, "The solid angle
+/// of a plane triangle", 1983): positive when p lies behind the triangle (opposite its
+/// counter-clockwise normal), in [-2 pi, 2 pi]. Summed over a closed mesh: 4 pi x the winding
+/// number at p.
+/// Every winding-number sum calls this one formula, so their results agree to the last bit.
+inline double solidAngle(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& p)
+{
+  const Vec3 u = a - p, v = b - p, w = c - p;
+  const double lu = u.norm(), lv = v.norm(), lw = w.norm();
+  const double num = u.dot(v.cross(w));
+  const double den = lu * lv * lw + u.dot(v) * lw + v.dot(w) * lu + w.dot(u) * lv;
+  return 2.0 * std::atan2(num, den);
+}
+
 /// Generalized winding number of a closed triangle mesh at p (about 1 inside, 0 outside).
 double windingNumber(const TriangleMesh& mesh, const Vec3& p);
 

@@ -443,12 +443,7 @@ double TriangleTree::windingNumber(const Vec3& p, double beta) const
     {
       for (int k = node.Start; k < node.Start + node.Count; ++k)
       {
-        // exact solid angle (Van Oosterom & Strackee)
-        const Vec3 a = Tri[k].P[0] - p, b = Tri[k].P[1] - p, c = Tri[k].P[2] - p;
-        const double la = a.norm(), lb = b.norm(), lc = c.norm();
-        const double num = a.dot(b.cross(c));
-        const double den = la * lb * lc + a.dot(b) * lc + b.dot(c) * la + c.dot(a) * lb;
-        total += 2.0 * std::atan2(num, den);
+        total += solidAngle(Tri[k].P[0], Tri[k].P[1], Tri[k].P[2], p); // exact
       }
       continue;
     }
