@@ -960,16 +960,16 @@ private:
       for (int f : ev.Changed)
       {
         const Triangle& t = T[f];
-        angle += solidAngle(x, P[t[0]], P[t[1]], P[t[2]]);
+        angle += solidAngle(P[t[0]], P[t[1]], P[t[2]], x);
         int ids[3];
         Vec3 pts[3];
         newTriangle(ev, f, p, ids, pts);
-        angle -= solidAngle(x, pts[0], pts[1], pts[2]);
+        angle -= solidAngle(pts[0], pts[1], pts[2], x);
       }
       for (int f : ev.Removed)
       {
         const Triangle& t = T[f];
-        angle += solidAngle(x, P[t[0]], P[t[1]], P[t[2]]);
+        angle += solidAngle(P[t[0]], P[t[1]], P[t[2]], x);
       }
       if (std::abs(angle) > 2.0 * M_PI) // |winding number| > 1/2
         return true;

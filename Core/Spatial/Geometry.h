@@ -47,14 +47,4 @@ inline double solidAngle(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3
 /// Generalized winding number of a closed triangle mesh at p (about 1 inside, 0 outside).
 double windingNumber(const TriangleMesh& mesh, const Vec3& p);
 
-/// Signed solid angle of triangle (a, b, c) seen from p (Van Oosterom & Strackee), in [-2 pi, 2 pi].
-inline double solidAngle(const Vec3& p, const Vec3& a, const Vec3& b, const Vec3& c)
-{
-  const Vec3 x = a - p, y = b - p, z = c - p;
-  const double lx = x.norm(), ly = y.norm(), lz = z.norm();
-  const double num = x.dot(y.cross(z));
-  const double den = lx * ly * lz + x.dot(y) * lz + y.dot(z) * lx + z.dot(x) * ly;
-  return 2.0 * std::atan2(num, den);
-}
-
 } // namespace sdfcage
