@@ -1,10 +1,9 @@
 #include "Pipeline/CageGenerator.h"
 
 #include "Common/Progress.h"
+#include "Common/Threads.h"
 #include "Quality/Verification.h"
 #include "Spatial/TriangleTree.h"
-
-#include <tbb/global_control.h>
 
 #include <chrono>
 #include <memory>
@@ -35,12 +34,7 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
 {
   CageResult result;
   const auto start = std::chrono::steady_clock::now();
-  std::unique_ptr<tbb::global_control> threads;
-  if (options.Envelope.NumberOfThreads > 0)
-  {
-    threads = std::make_unique<tbb::global_control>(
-      tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(options.Envelope.NumberOfThreads));
-  }
+  const ThreadLimit threads(options.NumberOfThreads);
 
   // 1. validation
   progressStage(progress, "validating input", 0.0, 0.02);

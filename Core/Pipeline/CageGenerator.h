@@ -12,6 +12,8 @@ namespace sdfcage
 
 struct CageOptions
 {
+  /// Worker threads of every stage (0 = all cores). The cage does not depend on it.
+  int NumberOfThreads = 0;
   EnvelopeOptions Envelope;
   ValidationOptions Validation;
   /// Target vertex count of the cage; 0 keeps the dense verified envelope as the cage.

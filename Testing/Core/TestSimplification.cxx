@@ -163,8 +163,8 @@ TEST(Simplification, DeterministicAcrossThreadCounts)
   const TriangleMesh input = makeBuiltinShape();
   CageOptions a, b;
   a.TargetNumberOfVertices = b.TargetNumberOfVertices = 400;
-  a.Envelope.NumberOfThreads = 1;
-  b.Envelope.NumberOfThreads = 2;
+  a.NumberOfThreads = 1;
+  b.NumberOfThreads = 2;
   const CageResult ra = generateCage(PolygonMesh::fromTriangles(input), a);
   const CageResult rb = generateCage(PolygonMesh::fromTriangles(input), b);
   ASSERT_EQ(ra.State, Status::Ok);

@@ -630,7 +630,7 @@ int TestParameters(const Context&)
     "MaximumRefinements default = Core's");
   c.Check((filter->GetGenerateDistanceField() != 0) == core.KeepDistanceField,
     "GenerateDistanceField default = Core's");
-  c.Check(filter->GetNumberOfThreads() == core.NumberOfThreads, "NumberOfThreads default = Core's");
+  c.Check(filter->GetNumberOfThreads() == sdfcage::CageOptions().NumberOfThreads, "NumberOfThreads default = Core's");
   c.Check(filter->GetIsoValue() == 0.01, "IsoValue default is the paper's 0.01");
   c.Check(filter->GetTargetNumberOfVertices() == sdfcage::CageOptions().TargetNumberOfVertices,
     "TargetNumberOfVertices default = Core's");
