@@ -43,6 +43,12 @@ vtkStandardNewMacro(vtkSDFCageFilter);
 using namespace sdfcage_vtk;
 
 //------------------------------------------------------------------------------
+struct vtkSDFCageFilter::vtkInternals
+{
+  sdfcage::ResultTable Results; // Core's table of the last execution
+};
+
+//------------------------------------------------------------------------------
 vtkSDFCageFilter::vtkSDFCageFilter()
 {
   // The defaults are Core's, so that the filter, the CLI and the plugin agree.
@@ -74,12 +80,6 @@ vtkSDFCageFilter::vtkSDFCageFilter()
   this->SetNumberOfOutputPorts(3);
   this->ResetResults();
 }
-
-//------------------------------------------------------------------------------
-struct vtkSDFCageFilter::vtkInternals
-{
-  sdfcage::ResultTable Results; // Core's table of the last execution
-};
 
 //------------------------------------------------------------------------------
 vtkSDFCageFilter::~vtkSDFCageFilter() = default;

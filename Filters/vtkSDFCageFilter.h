@@ -23,9 +23,11 @@
  * Optional optimization stage (§3.3, Optimize off by default): vertex relocation and edge flips
  * lower a MIPS or cage-spacing energy while every guarantee is kept (see vtkCageOptimizeFilter).
  *
- * The input must be a closed (watertight), manifold, consistently oriented surface: polygons and
- * triangle strips are triangulated, vertex and line cells are ignored, an inward-oriented mesh is
- * flipped (with a warning). Several components are allowed.
+ * Any surface is accepted: polygons and triangle strips are triangulated, coincident points
+ * merged, degenerate and duplicated triangles dropped, vertex and line cells ignored, a closed
+ * inward-oriented mesh flipped (with a warning). A closed, consistently oriented 2-manifold keeps
+ * the flood-fill inside; open, non-manifold or inconsistently oriented inputs are signed by their
+ * winding number (see SignMode). Several components are allowed.
  *
  * Outputs:
  * - port 0 ("Cage"): the cage, with point array `DistanceToInput` (double, input units) and
@@ -52,9 +54,9 @@
  * envelope are output. VTK 9.1 clears the abort flag when the next execution starts; the VTK
  * bundled with ParaView 5.11 keeps it set until SetAbortExecute(0).
  *
- * @warning The input must be closed: an open, non-manifold or degenerate input is rejected with
- * an error that names the defect and its count (e.g. "the mesh has 12 boundary edges ...") and
- * all outputs are empty. Self-intersecting inputs are not detected. If the envelope or the cage
+ * @warning An input without polygons, with non-finite points or invalid point ids is rejected
+ * with an error that names the defect, and all outputs are empty. Self-intersecting inputs are not
+ * detected. If the envelope or the cage
  * cannot be verified, that is an error too: the cage output stays empty and the envelope (if
  * any) is put on port 1 so the failure can be inspected. If the simplification cannot reach
  * TargetNumberOfVertices (no feasible collapse left), the cage it reached is output with a warning

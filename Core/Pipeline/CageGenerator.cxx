@@ -122,13 +122,13 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
     const std::shared_ptr<const TriangleTree> ownTree = env.InputTree ? nullptr : std::make_shared<TriangleTree>(unit);
     const TriangleTree& tree = env.InputTree ? *env.InputTree : *ownTree;
     SimplifyOptions so = options.Simplify;
-    so.TargetVertices = options.TargetNumberOfVertices;
+    so.TargetNumberOfVertices = options.TargetNumberOfVertices;
     so.Clearance = options.Envelope.clearance();
     progressStage(progress, "simplifying", 0.45, 0.95);
     result.Simplification = simplifyEnvelope(env.Envelope, tree, so, progress);
     result.SimplificationSeconds = result.Simplification.Seconds;
     result.VerticesReached = result.Simplification.VerticesReached;
-    result.TargetReached = result.Simplification.ReachedTarget;
+    result.TargetReached = result.Simplification.TargetReached;
     result.StopReason = result.Simplification.StopReason;
     // independent re-verification of the final cage (exact distances, winding numbers). It runs
     // even after a cancel: the partial cage is valid and usable.

@@ -1,5 +1,6 @@
 #include "Pipeline/Results.h"
 
+#include "Envelope/ActivePointAnalysis.h"
 #include "Pipeline/CageGenerator.h"
 #include "Quality/CageQuality.h"
 
@@ -193,6 +194,16 @@ ResultTable optimizeResults(const OptimizeResult& o, double measuredClearanceRel
     real("ClearanceUsed", o.ClearanceUsed, "relative", "the clearance enforced"),
   });
   return t;
+}
+
+ResultTable activePointResults(const ActivePointAnalysis& a)
+{
+  return {
+    integer("NumberOfActivePoints", static_cast<long long>(a.NumberOfActivePoints), "count", "input points found active (nearly touching another part)"),
+    integer("NumberOfActiveSamples", static_cast<long long>(a.NumberOfActiveSamples), "count", "samples of the active set A on the surface"),
+    integer("NumberOfSamples", static_cast<long long>(a.NumberOfSamples), "count", "samples of the surface"),
+    real("ActivePointTime", a.Seconds, "s", "the whole analysis"),
+  };
 }
 
 ResultTable qualityResults(const CageQualityResult& q)

@@ -10,6 +10,7 @@
 namespace sdfcage
 {
 
+struct ActivePointAnalysis;
 struct CageResult;
 struct CageQualityResult;
 struct OptimizeResult;
@@ -51,6 +52,9 @@ ResultTable cageResults(const CageResult& result);
 /// `measuredClearanceRelative` is r.MinimumClearance in unit-sphere units (`r` is in input
 /// units when it comes from optimizeCageInInputUnits).
 ResultTable optimizeResults(const OptimizeResult& r, double measuredClearanceRelative);
+
+/// The active-point analysis alone (vtkActivePointFilter).
+ResultTable activePointResults(const ActivePointAnalysis& a);
 
 /// The judge's verdict and measures (vtkCageQualityFilter, `sdfcage --check`); relative lengths
 /// are fractions of the input's bounding-box diagonal.

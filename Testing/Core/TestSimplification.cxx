@@ -136,7 +136,7 @@ TEST(Simplification, PlainQEMFailsWhereConstrainedPasses)
     ASSERT_EQ(env.State, Status::Ok) << env.Message;
     const TriangleTree tree(unit);
     SimplifyOptions so;
-    so.TargetVertices = 40;
+    so.TargetNumberOfVertices = 40;
     so.Clearance = eo.clearance();
     SimplifyOptions plain = so;
     plain.EnforceClearance = false;
