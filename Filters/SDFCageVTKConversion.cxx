@@ -6,10 +6,12 @@
 #include "vtkFloatArray.h"
 #include "vtkIdTypeArray.h"
 #include "vtkImageData.h"
+#include "vtkIntArray.h"
 #include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkSmartPointer.h"
+#include "vtkStringArray.h"
 
 #include <algorithm>
 
@@ -200,5 +202,44 @@ const char* StatusIdentifier(sdfcage::Status status)
   }
 }
 
+
+void AddResultArrays(vtkFieldData* fd, const sdfcage::ResultTable& results)
+{
+  for (const sdfcage::ResultField& f : results)
+  {
+    switch (f.Type)
+    {
+      case sdfcage::ResultField::Kind::Flag:
+        AddFieldValue<vtkIntArray>(fd, f.Name.c_str(), static_cast<int>(f.Integer));
+        break;
+      case sdfcage::ResultField::Kind::Integer:
+        AddFieldValue<vtkIdTypeArray>(fd, f.Name.c_str(), static_cast<vtkIdType>(f.Integer));
+        break;
+      case sdfcage::ResultField::Kind::Real:
+        AddFieldValue<vtkDoubleArray>(fd, f.Name.c_str(), f.Real);
+        break;
+      case sdfcage::ResultField::Kind::Text:
+        AddFieldValue<vtkStringArray>(fd, f.Name.c_str(), f.Text);
+        break;
+    }
+  }
+}
+
+double ResultNumber(const sdfcage::ResultTable& results, const char* name)
+{
+  const sdfcage::ResultField* f = name ? sdfcage::findResult(results, name) : nullptr;
+  return f ? f->number() : 0.0;
+}
+
+const char* ResultText(const sdfcage::ResultTable& results, const char* name)
+{
+  const sdfcage::ResultField* f = name ? sdfcage::findResult(results, name) : nullptr;
+  return f && f->Type == sdfcage::ResultField::Kind::Text ? f->Text.c_str() : "";
+}
+
+const char* ResultName(const sdfcage::ResultTable& results, int index)
+{
+  return index >= 0 && static_cast<std::size_t>(index) < results.size() ? results[static_cast<std::size_t>(index)].Name.c_str() : "";
+}
 
 } // namespace sdfcage_vtk

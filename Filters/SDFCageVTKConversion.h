@@ -9,6 +9,7 @@
 #include "Envelope/Envelope.h"
 #include "Mesh/Mesh.h"
 #include "Common/Progress.h"
+#include "Pipeline/Results.h"
 
 #include <string>
 #include <thread>
@@ -91,5 +92,16 @@ void AddFieldValue(vtkFieldData* fd, const char* name, ValueT value)
   array->SetValue(0, value);
   fd->AddArray(array);
 }
+
+/// One one-tuple array per result of Core's table, named like the result: flags as vtkIntArray
+/// (0/1), counts as vtkIdTypeArray, measures as vtkDoubleArray, texts as vtkStringArray.
+void AddResultArrays(vtkFieldData* fd, const sdfcage::ResultTable& results);
+
+/// A result by name for the filters' generic getters: flags as 0/1; 0 (or "") for texts, numbers
+/// and unknown names as the other kind.
+double ResultNumber(const sdfcage::ResultTable& results, const char* name);
+const char* ResultText(const sdfcage::ResultTable& results, const char* name);
+/// The name of result `index` ("" out of range).
+const char* ResultName(const sdfcage::ResultTable& results, int index);
 
 } // namespace sdfcage_vtk

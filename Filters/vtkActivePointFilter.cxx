@@ -30,8 +30,15 @@ vtkStandardNewMacro(vtkActivePointFilter);
 using namespace sdfcage_vtk;
 
 //------------------------------------------------------------------------------
+struct vtkActivePointFilter::vtkInternals
+{
+  sdfcage::ResultTable Results = sdfcage::activePointResults(sdfcage::ActivePointAnalysis());
+};
+
+//------------------------------------------------------------------------------
 vtkActivePointFilter::vtkActivePointFilter()
 {
+  this->Internals = std::make_unique<vtkInternals>();
   const sdfcage::ActivePointOptions defaults;
   this->ActiveRadius = defaults.Radius;
   this->GeodesicThreshold = defaults.GeodesicThreshold;
@@ -61,10 +68,7 @@ int vtkActivePointFilter::RequestData(
   vtkPolyData* input = vtkPolyData::GetData(inputVector[0], 0);
   vtkPolyData* output = vtkPolyData::GetData(outputVector, 0);
   vtkImageData* fields = vtkImageData::GetData(outputVector, 1);
-  this->NumberOfActivePoints = 0;
-  this->NumberOfActiveSamples = 0;
-  this->NumberOfSamples = 0;
-  this->ExecutionTime = 0.0;
+  this->Internals->Results = sdfcage::activePointResults(sdfcage::ActivePointAnalysis());
   this->LastErrorMessage.clear();
   if (!output || !fields)
   {
@@ -76,10 +80,7 @@ int vtkActivePointFilter::RequestData(
 
   auto publish = [&]() {
     vtkFieldData* fd = output->GetFieldData();
-    AddFieldValue<vtkIdTypeArray>(fd, "NumberOfActivePoints", this->NumberOfActivePoints);
-    AddFieldValue<vtkIdTypeArray>(fd, "NumberOfActiveSamples", this->NumberOfActiveSamples);
-    AddFieldValue<vtkIdTypeArray>(fd, "NumberOfSamples", this->NumberOfSamples);
-    AddFieldValue<vtkDoubleArray>(fd, "ActivePointTime", this->ExecutionTime);
+    AddResultArrays(fd, this->Internals->Results);
     AddFieldValue<vtkStringArray>(fd, "Status", this->StatusString);
     AddFieldValue<vtkStringArray>(fd, "LastErrorMessage", this->LastErrorMessage);
   };
@@ -114,7 +115,9 @@ int vtkActivePointFilter::RequestData(
     FilterProgress progress(this);
     const sdfcage::ActivePointAnalysis result = sdfcage::analyzeActivePoints(mesh, options, &progress);
     this->StatusString = StatusIdentifier(result.State);
-    this->ExecutionTime = result.Seconds;
+    sdfcage::ActivePointAnalysis timeOnly; // the counts are published for a complete analysis only
+    timeOnly.Seconds = result.Seconds;
+    this->Internals->Results = sdfcage::activePointResults(result.State == sdfcage::Status::Ok ? result : timeOnly);
     switch (result.State)
     {
       case sdfcage::Status::Ok:
@@ -156,9 +159,6 @@ int vtkActivePointFilter::RequestData(
       ToImageData(result.SignedDistance, fields, "SignedDistance");
       ToImageData(result.ModifiedSignedDistance, fields, "ModifiedSignedDistance");
     }
-    this->NumberOfActivePoints = static_cast<vtkIdType>(result.NumberOfActivePoints);
-    this->NumberOfActiveSamples = static_cast<vtkIdType>(result.NumberOfActiveSamples);
-    this->NumberOfSamples = static_cast<vtkIdType>(result.NumberOfSamples);
     publish();
     return 1;
   }
@@ -186,7 +186,25 @@ void vtkActivePointFilter::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "AmplificationBeta: " << this->AmplificationBeta << "\n";
   os << indent << "GenerateDistanceFields: " << (this->GenerateDistanceFields ? "On" : "Off") << "\n";
   os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";
-  os << indent << "NumberOfActivePoints: " << this->NumberOfActivePoints << "\n";
-  os << indent << "NumberOfActiveSamples: " << this->NumberOfActiveSamples << "\n";
   os << indent << "Status: " << this->StatusString << "\n";
+  for (const sdfcage::ResultField& f : this->Internals->Results)
+  {
+    os << indent << f.Name << ": " << f.toString() << "\n";
+  }
+}
+
+//------------------------------------------------------------------------------
+double vtkActivePointFilter::GetResultNumber(const char* name) const
+{
+  return ResultNumber(this->Internals->Results, name);
+}
+
+int vtkActivePointFilter::GetNumberOfResults() const
+{
+  return static_cast<int>(this->Internals->Results.size());
+}
+
+const char* vtkActivePointFilter::GetResultName(int index) const
+{
+  return ResultName(this->Internals->Results, index);
 }

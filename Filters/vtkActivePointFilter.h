@@ -41,6 +41,7 @@
 #include "SDFCageFiltersModule.h" // For export macro
 #include "vtkPolyDataAlgorithm.h"
 
+#include <memory> // For the results table
 #include <string> // For the status strings
 
 class SDFCAGEFILTERS_EXPORT vtkActivePointFilter : public vtkPolyDataAlgorithm
@@ -97,12 +98,23 @@ public:
    * the time in seconds, the status ("Ok", "EmptyInput", "InvalidInput", "Cancelled", "Failed")
    * and the last error message.
    */
-  vtkGetMacro(NumberOfActivePoints, vtkIdType);
-  vtkGetMacro(NumberOfActiveSamples, vtkIdType);
-  vtkGetMacro(NumberOfSamples, vtkIdType);
-  vtkGetMacro(ExecutionTime, double);
+  vtkIdType GetNumberOfActivePoints() const { return static_cast<vtkIdType>(this->GetResultNumber("NumberOfActivePoints")); }
+  vtkIdType GetNumberOfActiveSamples() const { return static_cast<vtkIdType>(this->GetResultNumber("NumberOfActiveSamples")); }
+  vtkIdType GetNumberOfSamples() const { return static_cast<vtkIdType>(this->GetResultNumber("NumberOfSamples")); }
+  double GetActivePointTime() const { return this->GetResultNumber("ActivePointTime"); }
+  double GetExecutionTime() const { return this->GetActivePointTime(); } ///< the old name of GetActivePointTime
   const char* GetStatusString() const { return this->StatusString.c_str(); }
   const char* GetLastErrorMessage() const { return this->LastErrorMessage.c_str(); }
+  ///@}
+
+  ///@{
+  /**
+   * The same results by name, as in output 0's field data (Core's sdfcage::activePointResults
+   * table, in its order); 0 for unknown names.
+   */
+  double GetResultNumber(const char* name) const;
+  int GetNumberOfResults() const;
+  const char* GetResultName(int index) const; ///< "" out of range
   ///@}
 
 protected:
@@ -119,16 +131,16 @@ protected:
   vtkTypeBool GenerateDistanceFields = 0;
   int NumberOfThreads = 0;
 
-  vtkIdType NumberOfActivePoints = 0;
-  vtkIdType NumberOfActiveSamples = 0;
-  vtkIdType NumberOfSamples = 0;
-  double ExecutionTime = 0.0;
+  // outcome of the last execution (the results are in Internals' table)
   std::string StatusString;
   std::string LastErrorMessage;
 
 private:
   vtkActivePointFilter(const vtkActivePointFilter&) = delete;
   void operator=(const vtkActivePointFilter&) = delete;
+
+  struct vtkInternals;
+  std::unique_ptr<vtkInternals> Internals;
 };
 
 #endif

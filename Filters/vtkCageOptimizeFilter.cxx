@@ -30,6 +30,12 @@ vtkStandardNewMacro(vtkCageOptimizeFilter);
 using namespace sdfcage_vtk;
 
 //------------------------------------------------------------------------------
+struct vtkCageOptimizeFilter::vtkInternals
+{
+  sdfcage::ResultTable Results; // Core's table of the last execution
+};
+
+//------------------------------------------------------------------------------
 vtkCageOptimizeFilter::vtkCageOptimizeFilter()
 {
   // The defaults are Core's, so that the filter, the CLI and the plugin agree.
@@ -41,6 +47,7 @@ vtkCageOptimizeFilter::vtkCageOptimizeFilter()
   this->NumberOfIterations = defaults.NumberOfIterations;
   this->EdgeFlips = defaults.EdgeFlips ? 1 : 0;
   this->MinimumClearance = defaults.Clearance;
+  this->Internals = std::make_unique<vtkInternals>();
   this->SetNumberOfInputPorts(2);
   this->SetNumberOfOutputPorts(1);
   this->ResetResults();
@@ -64,19 +71,39 @@ void vtkCageOptimizeFilter::SetSourceData(vtkDataObject* source)
 //------------------------------------------------------------------------------
 void vtkCageOptimizeFilter::ResetResults()
 {
-  this->EnergyBefore = 0.0;
-  this->EnergyAfter = 0.0;
-  this->MinimumAngleBefore = 0.0;
-  this->MinimumAngleAfter = 0.0;
-  this->MeasuredClearance = 0.0;
-  this->MeasuredClearanceRelative = 0.0;
-  this->ClearanceUsed = 0.0;
-  this->NumberOfMoves = 0;
-  this->NumberOfFlips = 0;
-  this->Reverted = false;
-  this->OptimizationTime = 0.0;
+  this->Internals->Results = sdfcage::optimizeResults(sdfcage::OptimizeResult(), 0.0);
   this->StatusString = "NotExecuted";
   this->LastErrorMessage.clear();
+}
+
+//------------------------------------------------------------------------------
+void vtkCageOptimizeFilter::PublishResults(vtkPolyData* output) const
+{
+  vtkFieldData* fd = output->GetFieldData();
+  AddResultArrays(fd, this->Internals->Results);
+  AddFieldValue<vtkStringArray>(fd, "Status", this->StatusString);
+  AddFieldValue<vtkStringArray>(fd, "LastErrorMessage", this->LastErrorMessage);
+}
+
+//------------------------------------------------------------------------------
+double vtkCageOptimizeFilter::GetResultNumber(const char* name) const
+{
+  return ResultNumber(this->Internals->Results, name);
+}
+
+const char* vtkCageOptimizeFilter::GetResultText(const char* name) const
+{
+  return ResultText(this->Internals->Results, name);
+}
+
+int vtkCageOptimizeFilter::GetNumberOfResults() const
+{
+  return static_cast<int>(this->Internals->Results.size());
+}
+
+const char* vtkCageOptimizeFilter::GetResultName(int index) const
+{
+  return ResultName(this->Internals->Results, index);
 }
 
 //------------------------------------------------------------------------------
@@ -106,22 +133,7 @@ int vtkCageOptimizeFilter::RequestData(vtkInformation* vtkNotUsed(request),
   }
   output->Initialize();
 
-  auto publish = [&]() {
-    vtkFieldData* fd = output->GetFieldData();
-    AddFieldValue<vtkDoubleArray>(fd, "EnergyBefore", this->EnergyBefore);
-    AddFieldValue<vtkDoubleArray>(fd, "EnergyAfter", this->EnergyAfter);
-    AddFieldValue<vtkDoubleArray>(fd, "MinimumAngleBefore", this->MinimumAngleBefore);
-    AddFieldValue<vtkDoubleArray>(fd, "MinimumAngleAfter", this->MinimumAngleAfter);
-    AddFieldValue<vtkDoubleArray>(fd, "MeasuredClearance", this->MeasuredClearance);
-    AddFieldValue<vtkDoubleArray>(fd, "MeasuredClearanceRelative", this->MeasuredClearanceRelative);
-    AddFieldValue<vtkDoubleArray>(fd, "ClearanceUsed", this->ClearanceUsed);
-    AddFieldValue<vtkIntArray>(fd, "NumberOfMoves", this->NumberOfMoves);
-    AddFieldValue<vtkIntArray>(fd, "NumberOfFlips", this->NumberOfFlips);
-    AddFieldValue<vtkIntArray>(fd, "Reverted", this->Reverted ? 1 : 0);
-    AddFieldValue<vtkDoubleArray>(fd, "OptimizationTime", this->OptimizationTime);
-    AddFieldValue<vtkStringArray>(fd, "Status", this->StatusString);
-    AddFieldValue<vtkStringArray>(fd, "LastErrorMessage", this->LastErrorMessage);
-  };
+  auto publish = [&]() { this->PublishResults(output); };
   auto fail = [&](const std::string& status, const std::string& message) {
     output->Initialize();
     this->StatusString = status;
@@ -170,17 +182,7 @@ int vtkCageOptimizeFilter::RequestData(vtkInformation* vtkNotUsed(request),
     const sdfcage::OptimizeResult r = sdfcage::optimizeCageInInputUnits(cageMesh, sourceMesh, options, &progress);
     const sdfcage::Normalization n = sdfcage::Normalization::fit(sourceMesh);
 
-    this->EnergyBefore = r.EnergyBefore;
-    this->EnergyAfter = r.EnergyAfter;
-    this->MinimumAngleBefore = r.MinimumAngleBefore;
-    this->MinimumAngleAfter = r.MinimumAngleAfter;
-    this->MeasuredClearance = r.MinimumClearance;
-    this->MeasuredClearanceRelative = n.lengthToUnit(r.MinimumClearance);
-    this->ClearanceUsed = r.ClearanceUsed;
-    this->NumberOfMoves = static_cast<int>(r.Moves);
-    this->NumberOfFlips = static_cast<int>(r.Flips);
-    this->Reverted = r.Reverted;
-    this->OptimizationTime = r.Seconds;
+    this->Internals->Results = sdfcage::optimizeResults(r, n.lengthToUnit(r.MinimumClearance));
     this->StatusString = StatusIdentifier(r.State);
     this->LastErrorMessage = r.Message;
 
@@ -232,8 +234,8 @@ void vtkCageOptimizeFilter::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "MinimumClearance: " << this->MinimumClearance << "\n";
   os << indent << "Status: " << this->StatusString << "\n";
   os << indent << "LastErrorMessage: " << this->LastErrorMessage << "\n";
-  os << indent << "EnergyBefore: " << this->EnergyBefore << "\n";
-  os << indent << "EnergyAfter: " << this->EnergyAfter << "\n";
-  os << indent << "MeasuredClearance: " << this->MeasuredClearance << "\n";
-  os << indent << "OptimizationTime: " << this->OptimizationTime << "\n";
+  for (const sdfcage::ResultField& f : this->Internals->Results)
+  {
+    os << indent << f.Name << ": " << f.toString() << "\n";
+  }
 }

@@ -50,6 +50,7 @@
 #include "SDFCageFiltersModule.h" // For export macro
 #include "vtkPolyDataAlgorithm.h"
 
+#include <memory> // For the results table
 #include <string> // For the status strings
 
 class SDFCAGEFILTERS_EXPORT vtkCageOptimizeFilter : public vtkPolyDataAlgorithm
@@ -144,17 +145,28 @@ public:
    * the input (input units and relative), the clearance enforced (relative), the accepted
    * vertex moves and flips, whether the result was reverted, and the time in seconds.
    */
-  vtkGetMacro(EnergyBefore, double);
-  vtkGetMacro(EnergyAfter, double);
-  vtkGetMacro(MinimumAngleBefore, double);
-  vtkGetMacro(MinimumAngleAfter, double);
-  vtkGetMacro(MeasuredClearance, double);
-  vtkGetMacro(MeasuredClearanceRelative, double);
-  vtkGetMacro(ClearanceUsed, double);
-  vtkGetMacro(NumberOfMoves, int);
-  vtkGetMacro(NumberOfFlips, int);
-  vtkGetMacro(Reverted, bool);
-  vtkGetMacro(OptimizationTime, double);
+  double GetEnergyBefore() const { return this->GetResultNumber("EnergyBefore"); }
+  double GetEnergyAfter() const { return this->GetResultNumber("EnergyAfter"); }
+  double GetMinimumAngleBefore() const { return this->GetResultNumber("MinimumAngleBefore"); }
+  double GetMinimumAngleAfter() const { return this->GetResultNumber("MinimumAngleAfter"); }
+  double GetMeasuredClearance() const { return this->GetResultNumber("MeasuredClearance"); }
+  double GetMeasuredClearanceRelative() const { return this->GetResultNumber("MeasuredClearanceRelative"); }
+  double GetClearanceUsed() const { return this->GetResultNumber("ClearanceUsed"); }
+  int GetNumberOfMoves() const { return static_cast<int>(this->GetResultNumber("NumberOfMoves")); }
+  int GetNumberOfFlips() const { return static_cast<int>(this->GetResultNumber("NumberOfFlips")); }
+  bool GetReverted() const { return this->GetResultNumber("Reverted") != 0; }
+  double GetOptimizationTime() const { return this->GetResultNumber("OptimizationTime"); }
+  ///@}
+
+  ///@{
+  /**
+   * The same results by name, as in the output's field data (Core's sdfcage::optimizeResults
+   * table, in its order); GetResultNumber gives flags as 0/1 and 0 for unknown names.
+   */
+  double GetResultNumber(const char* name) const;
+  const char* GetResultText(const char* name) const;
+  int GetNumberOfResults() const;
+  const char* GetResultName(int index) const; ///< "" out of range
   ///@}
 
   /**
@@ -181,17 +193,7 @@ protected:
   vtkTypeBool EdgeFlips;
   double MinimumClearance;
 
-  double EnergyBefore = 0.0;
-  double EnergyAfter = 0.0;
-  double MinimumAngleBefore = 0.0;
-  double MinimumAngleAfter = 0.0;
-  double MeasuredClearance = 0.0;
-  double MeasuredClearanceRelative = 0.0;
-  double ClearanceUsed = 0.0;
-  int NumberOfMoves = 0;
-  int NumberOfFlips = 0;
-  bool Reverted = false;
-  double OptimizationTime = 0.0;
+  // outcome of the last execution (the results are in Internals' table)
   std::string StatusString;
   std::string LastErrorMessage;
 
@@ -200,6 +202,10 @@ private:
   void operator=(const vtkCageOptimizeFilter&) = delete;
 
   void ResetResults();
+  void PublishResults(vtkPolyData* output) const;
+
+  struct vtkInternals;
+  std::unique_ptr<vtkInternals> Internals;
 };
 
 #endif

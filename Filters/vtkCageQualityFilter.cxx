@@ -27,6 +27,7 @@
 
 #include "Quality/CageQuality.h"
 #include "Common/Progress.h"
+#include "SDFCageVTKConversion.h"
 
 #include <cmath>
 #include <exception>
@@ -132,16 +133,6 @@ void ToTriangles(vtkPolyData* data, sdfcage::TriangleMesh& mesh, std::vector<vtk
   }
 }
 
-template <class ArrayT, class ValueT>
-void AddFieldValue(vtkFieldData* fd, const char* name, const ValueT& value)
-{
-  vtkNew<ArrayT> array;
-  array->SetName(name);
-  array->SetNumberOfTuples(1);
-  array->SetValue(0, value);
-  fd->AddArray(array);
-}
-
 vtkSmartPointer<vtkDoubleArray> NewArray(const char* name, vtkIdType n)
 {
   auto array = vtkSmartPointer<vtkDoubleArray>::New();
@@ -153,8 +144,16 @@ vtkSmartPointer<vtkDoubleArray> NewArray(const char* name, vtkIdType n)
 } // namespace
 
 //------------------------------------------------------------------------------
+struct vtkCageQualityFilter::vtkInternals
+{
+  sdfcage::ResultTable Results; // Core's table of the last execution
+};
+
+//------------------------------------------------------------------------------
 vtkCageQualityFilter::vtkCageQualityFilter()
 {
+  this->Internals = std::make_unique<vtkInternals>();
+  this->ResetResults();
   this->HausdorffTolerance = sdfcage::CageQualityOptions().HausdorffTolerance;
   this->SetNumberOfInputPorts(2);
   this->SetNumberOfOutputPorts(1);
@@ -194,15 +193,7 @@ int vtkCageQualityFilter::FillInputPortInformation(int port, vtkInformation* inf
 //------------------------------------------------------------------------------
 void vtkCageQualityFilter::ResetResults()
 {
-  this->Encloses = false;
-  this->MinimumClearance = this->MinimumClearanceRelative = 0.0;
-  this->HausdorffCageToInput = this->HausdorffCageToInputRelative = this->HausdorffCageToInputBound = 0.0;
-  this->HausdorffInputToCage = this->HausdorffInputToCageRelative = this->HausdorffInputToCageBound = 0.0;
-  this->MeanDistanceCageToInput = this->MeanDistanceCageToInputRelative = 0.0;
-  this->SelfIntersections = this->InputIntersections = this->InputVerticesOutside = 0;
-  this->CageGenus = this->InputGenus = -1;
-  this->QualityTime = 0.0;
-  this->QualityMessage.clear();
+  this->Internals->Results = sdfcage::qualityResults(sdfcage::CageQualityResult());
 }
 
 //------------------------------------------------------------------------------
@@ -231,27 +222,7 @@ int vtkCageQualityFilter::RequestData(vtkInformation* vtkNotUsed(request),
   }
   output->ShallowCopy(cage);
 
-  auto publish = [&]() {
-    vtkFieldData* fd = output->GetFieldData();
-    AddFieldValue<vtkIntArray>(fd, "Encloses", this->Encloses ? 1 : 0);
-    AddFieldValue<vtkDoubleArray>(fd, "MinimumClearance", this->MinimumClearance);
-    AddFieldValue<vtkDoubleArray>(fd, "MinimumClearanceRelative", this->MinimumClearanceRelative);
-    AddFieldValue<vtkDoubleArray>(fd, "HausdorffCageToInput", this->HausdorffCageToInput);
-    AddFieldValue<vtkDoubleArray>(fd, "HausdorffCageToInputRelative", this->HausdorffCageToInputRelative);
-    AddFieldValue<vtkDoubleArray>(fd, "HausdorffCageToInputBound", this->HausdorffCageToInputBound);
-    AddFieldValue<vtkDoubleArray>(fd, "HausdorffInputToCage", this->HausdorffInputToCage);
-    AddFieldValue<vtkDoubleArray>(fd, "HausdorffInputToCageRelative", this->HausdorffInputToCageRelative);
-    AddFieldValue<vtkDoubleArray>(fd, "HausdorffInputToCageBound", this->HausdorffInputToCageBound);
-    AddFieldValue<vtkDoubleArray>(fd, "MeanDistanceCageToInput", this->MeanDistanceCageToInput);
-    AddFieldValue<vtkDoubleArray>(fd, "MeanDistanceCageToInputRelative", this->MeanDistanceCageToInputRelative);
-    AddFieldValue<vtkIdTypeArray>(fd, "SelfIntersections", this->SelfIntersections);
-    AddFieldValue<vtkIdTypeArray>(fd, "InputIntersections", this->InputIntersections);
-    AddFieldValue<vtkIdTypeArray>(fd, "InputVerticesOutside", this->InputVerticesOutside);
-    AddFieldValue<vtkIntArray>(fd, "CageGenus", this->CageGenus);
-    AddFieldValue<vtkIntArray>(fd, "InputGenus", this->InputGenus);
-    AddFieldValue<vtkDoubleArray>(fd, "QualityTime", this->QualityTime);
-    AddFieldValue<vtkStringArray>(fd, "QualityMessage", this->QualityMessage);
-  };
+  auto publish = [&]() { sdfcage_vtk::AddResultArrays(output->GetFieldData(), this->Internals->Results); };
 
   try
   {
@@ -301,25 +272,7 @@ int vtkCageQualityFilter::RequestData(vtkInformation* vtkNotUsed(request),
     output->GetCellData()->AddArray(mips);
     output->GetPointData()->SetActiveScalars("DistanceToInput");
 
-    const double diagonal = q.Diagonal > 0 ? q.Diagonal : 1.0;
-    this->Encloses = q.Encloses;
-    this->MinimumClearance = q.MinimumClearance;
-    this->MinimumClearanceRelative = q.MinimumClearance / diagonal;
-    this->HausdorffCageToInput = q.HausdorffCageToInput;
-    this->HausdorffCageToInputRelative = q.HausdorffCageToInput / diagonal;
-    this->HausdorffCageToInputBound = q.HausdorffCageToInputBound;
-    this->HausdorffInputToCage = q.HausdorffInputToCage;
-    this->HausdorffInputToCageRelative = q.HausdorffInputToCage / diagonal;
-    this->HausdorffInputToCageBound = q.HausdorffInputToCageBound;
-    this->MeanDistanceCageToInput = q.MeanDistanceCageToInput;
-    this->MeanDistanceCageToInputRelative = q.MeanDistanceCageToInput / diagonal;
-    this->SelfIntersections = static_cast<vtkIdType>(q.SelfIntersections);
-    this->InputIntersections = static_cast<vtkIdType>(q.InputIntersections);
-    this->InputVerticesOutside = static_cast<vtkIdType>(q.InputVerticesOutside);
-    this->CageGenus = q.CageGenus;
-    this->InputGenus = q.InputGenus;
-    this->QualityTime = q.Seconds;
-    this->QualityMessage = q.Message;
+    this->Internals->Results = sdfcage::qualityResults(q);
     publish();
     this->UpdateProgress(1.0);
     return 1;
@@ -345,15 +298,29 @@ void vtkCageQualityFilter::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "HausdorffTolerance: " << this->HausdorffTolerance << "\n";
-  os << indent << "Encloses: " << this->Encloses << "\n";
-  os << indent << "MinimumClearance: " << this->MinimumClearance << "\n";
-  os << indent << "HausdorffCageToInput: " << this->HausdorffCageToInput << "\n";
-  os << indent << "HausdorffInputToCage: " << this->HausdorffInputToCage << "\n";
-  os << indent << "MeanDistanceCageToInput: " << this->MeanDistanceCageToInput << "\n";
-  os << indent << "SelfIntersections: " << this->SelfIntersections << "\n";
-  os << indent << "InputIntersections: " << this->InputIntersections << "\n";
-  os << indent << "InputVerticesOutside: " << this->InputVerticesOutside << "\n";
-  os << indent << "CageGenus: " << this->CageGenus << "\n";
-  os << indent << "InputGenus: " << this->InputGenus << "\n";
-  os << indent << "QualityMessage: " << this->QualityMessage << "\n";
+  for (const sdfcage::ResultField& f : this->Internals->Results)
+  {
+    os << indent << f.Name << ": " << f.toString() << "\n";
+  }
+}
+
+//------------------------------------------------------------------------------
+double vtkCageQualityFilter::GetResultNumber(const char* name) const
+{
+  return sdfcage_vtk::ResultNumber(this->Internals->Results, name);
+}
+
+const char* vtkCageQualityFilter::GetResultText(const char* name) const
+{
+  return sdfcage_vtk::ResultText(this->Internals->Results, name);
+}
+
+int vtkCageQualityFilter::GetNumberOfResults() const
+{
+  return static_cast<int>(this->Internals->Results.size());
+}
+
+const char* vtkCageQualityFilter::GetResultName(int index) const
+{
+  return sdfcage_vtk::ResultName(this->Internals->Results, index);
 }

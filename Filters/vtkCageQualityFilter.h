@@ -58,6 +58,7 @@
 #include "SDFCageFiltersModule.h" // For export macro
 #include "vtkPolyDataAlgorithm.h"
 
+#include <memory> // For the results table
 #include <string> // For the message
 
 class SDFCAGEFILTERS_EXPORT vtkCageQualityFilter : public vtkPolyDataAlgorithm
@@ -90,24 +91,35 @@ public:
   /**
    * Results, valid after the filter has executed (also in the output's field data).
    */
-  vtkGetMacro(Encloses, bool);
-  vtkGetMacro(MinimumClearance, double);
-  vtkGetMacro(MinimumClearanceRelative, double);
-  vtkGetMacro(HausdorffCageToInput, double);
-  vtkGetMacro(HausdorffCageToInputRelative, double);
-  vtkGetMacro(HausdorffCageToInputBound, double);
-  vtkGetMacro(HausdorffInputToCage, double);
-  vtkGetMacro(HausdorffInputToCageRelative, double);
-  vtkGetMacro(HausdorffInputToCageBound, double);
-  vtkGetMacro(MeanDistanceCageToInput, double);
-  vtkGetMacro(MeanDistanceCageToInputRelative, double);
-  vtkGetMacro(SelfIntersections, vtkIdType);
-  vtkGetMacro(InputIntersections, vtkIdType);
-  vtkGetMacro(InputVerticesOutside, vtkIdType);
-  vtkGetMacro(CageGenus, int);
-  vtkGetMacro(InputGenus, int);
-  vtkGetMacro(QualityTime, double);
-  const char* GetQualityMessage() const { return this->QualityMessage.c_str(); }
+  bool GetEncloses() const { return this->GetResultNumber("Encloses") != 0; }
+  double GetMinimumClearance() const { return this->GetResultNumber("MinimumClearance"); }
+  double GetMinimumClearanceRelative() const { return this->GetResultNumber("MinimumClearanceRelative"); }
+  double GetHausdorffCageToInput() const { return this->GetResultNumber("HausdorffCageToInput"); }
+  double GetHausdorffCageToInputRelative() const { return this->GetResultNumber("HausdorffCageToInputRelative"); }
+  double GetHausdorffCageToInputBound() const { return this->GetResultNumber("HausdorffCageToInputBound"); }
+  double GetHausdorffInputToCage() const { return this->GetResultNumber("HausdorffInputToCage"); }
+  double GetHausdorffInputToCageRelative() const { return this->GetResultNumber("HausdorffInputToCageRelative"); }
+  double GetHausdorffInputToCageBound() const { return this->GetResultNumber("HausdorffInputToCageBound"); }
+  double GetMeanDistanceCageToInput() const { return this->GetResultNumber("MeanDistanceCageToInput"); }
+  double GetMeanDistanceCageToInputRelative() const { return this->GetResultNumber("MeanDistanceCageToInputRelative"); }
+  vtkIdType GetSelfIntersections() const { return static_cast<vtkIdType>(this->GetResultNumber("SelfIntersections")); }
+  vtkIdType GetInputIntersections() const { return static_cast<vtkIdType>(this->GetResultNumber("InputIntersections")); }
+  vtkIdType GetInputVerticesOutside() const { return static_cast<vtkIdType>(this->GetResultNumber("InputVerticesOutside")); }
+  int GetCageGenus() const { return static_cast<int>(this->GetResultNumber("CageGenus")); }
+  int GetInputGenus() const { return static_cast<int>(this->GetResultNumber("InputGenus")); }
+  double GetQualityTime() const { return this->GetResultNumber("QualityTime"); }
+  const char* GetQualityMessage() const { return this->GetResultText("QualityMessage"); }
+  ///@}
+
+  ///@{
+  /**
+   * The same results by name, as in the output's field data (Core's sdfcage::qualityResults
+   * table, in its order); GetResultNumber gives flags as 0/1 and 0 for unknown names.
+   */
+  double GetResultNumber(const char* name) const;
+  const char* GetResultText(const char* name) const;
+  int GetNumberOfResults() const;
+  const char* GetResultName(int index) const; ///< "" out of range
   ///@}
 
 protected:
@@ -119,27 +131,11 @@ protected:
 
   double HausdorffTolerance;
 
-  bool Encloses = false;
-  double MinimumClearance = 0.0;
-  double MinimumClearanceRelative = 0.0;
-  double HausdorffCageToInput = 0.0;
-  double HausdorffCageToInputRelative = 0.0;
-  double HausdorffCageToInputBound = 0.0;
-  double HausdorffInputToCage = 0.0;
-  double HausdorffInputToCageRelative = 0.0;
-  double HausdorffInputToCageBound = 0.0;
-  double MeanDistanceCageToInput = 0.0;
-  double MeanDistanceCageToInputRelative = 0.0;
-  vtkIdType SelfIntersections = 0;
-  vtkIdType InputIntersections = 0;
-  vtkIdType InputVerticesOutside = 0;
-  int CageGenus = -1;
-  int InputGenus = -1;
-  double QualityTime = 0.0;
-  std::string QualityMessage;
-
 private:
   void ResetResults();
+  struct vtkInternals;
+  std::unique_ptr<vtkInternals> Internals;
+
   vtkCageQualityFilter(const vtkCageQualityFilter&) = delete;
   void operator=(const vtkCageQualityFilter&) = delete;
 };

@@ -43,6 +43,12 @@ vtkStandardNewMacro(vtkSDFCageFilter);
 using namespace sdfcage_vtk;
 
 //------------------------------------------------------------------------------
+struct vtkSDFCageFilter::vtkInternals
+{
+  sdfcage::ResultTable Results; // Core's table of the last execution
+};
+
+//------------------------------------------------------------------------------
 vtkSDFCageFilter::vtkSDFCageFilter()
 {
   // The defaults are Core's, so that the filter, the CLI and the plugin agree.
@@ -60,7 +66,7 @@ vtkSDFCageFilter::vtkSDFCageFilter()
   this->GeodesicThreshold = defaults.ActivePoints.GeodesicThreshold;
   this->AmplificationAlpha = defaults.ActivePoints.Alpha;
   this->AmplificationBeta = defaults.ActivePoints.Beta;
-  this->NumberOfThreads = defaults.NumberOfThreads;
+  this->NumberOfThreads = cageDefaults.NumberOfThreads;
   this->Optimize = cageDefaults.Optimize ? 1 : 0;
   this->Energy = static_cast<int>(cageDefaults.Optimization.Energy);
   this->TargetSpacing = cageDefaults.Optimization.TargetSpacing;
@@ -69,6 +75,7 @@ vtkSDFCageFilter::vtkSDFCageFilter()
   this->NumberOfIterations = cageDefaults.Optimization.NumberOfIterations;
   this->EdgeFlips = cageDefaults.Optimization.EdgeFlips ? 1 : 0;
 
+  this->Internals = std::make_unique<vtkInternals>();
   this->SetNumberOfInputPorts(1);
   this->SetNumberOfOutputPorts(3);
   this->ResetResults();
@@ -80,32 +87,8 @@ vtkSDFCageFilter::~vtkSDFCageFilter() = default;
 //------------------------------------------------------------------------------
 void vtkSDFCageFilter::ResetResults()
 {
-  this->ValidationTime = 0.0;
-  this->DistanceFieldTime = 0.0;
-  this->IsosurfaceTime = 0.0;
-  this->VerificationTime = 0.0;
-  this->SimplificationTime = 0.0;
-  this->CageVerificationTime = 0.0;
-  this->TotalTime = 0.0;
-  this->EnergyBefore = 0.0;
-  this->EnergyAfter = 0.0;
-  this->OptimizationTime = 0.0;
-  this->VerticesReached = 0;
-  this->TargetReached = false;
-  this->StopReason.clear();
-  this->MeasuredClearance = 0.0;
-  this->MeasuredClearanceRelative = 0.0;
-  this->EnclosureVerified = false;
-  this->RemovedPockets = 0;
-  this->EnvelopeGenus = 0;
-  this->EnvelopeComponents = 0;
-  this->VoxelSizeUsed = 0.0;
-  this->InputWasFlipped = false;
-  this->NumberOfActivePoints = 0;
-  this->ActivePointTime = 0.0;
-  this->TopologyWarning.clear();
-  this->ResultNumbers.clear();
-  this->ResultTexts.clear();
+  // the table of a run that did not happen: every result present, with its "nothing" value
+  this->Internals->Results = sdfcage::cageResults(sdfcage::CageResult());
   this->StatusString = "NotExecuted";
   this->LastErrorMessage.clear();
 }
@@ -120,6 +103,43 @@ int vtkSDFCageFilter::FillOutputPortInformation(int port, vtkInformation* info)
   }
   return this->Superclass::FillOutputPortInformation(port, info);
 }
+
+namespace
+{
+//------------------------------------------------------------------------------
+// The filter's parameters as Core's options.
+sdfcage::CageOptions CageOptionsOf(vtkSDFCageFilter* f)
+{
+  sdfcage::CageOptions options;
+  options.TargetNumberOfVertices = f->GetTargetNumberOfVertices();
+  options.NumberOfThreads = f->GetNumberOfThreads();
+  options.Envelope.IsoValue = f->GetIsoValue();
+  options.Envelope.VoxelSize = f->GetVoxelSize();
+  options.Envelope.MinimumClearance = f->GetMinimumClearance();
+  options.Envelope.Adaptivity = f->GetAdaptivity();
+  options.Envelope.MaximumRefinements = f->GetMaximumRefinements();
+  options.Envelope.KeepDistanceField = f->GetGenerateDistanceField() != 0;
+  options.Envelope.UseActivePoints = f->GetUseActivePoints() != 0;
+  options.Envelope.ActivePoints.Radius = f->GetActiveRadius();
+  options.Envelope.ActivePoints.GeodesicThreshold = f->GetGeodesicThreshold();
+  options.Envelope.ActivePoints.Alpha = f->GetAmplificationAlpha();
+  options.Envelope.ActivePoints.Beta = f->GetAmplificationBeta();
+  options.Envelope.Sign = static_cast<sdfcage::SignMode>(f->GetSignMode());
+  options.Optimize = f->GetOptimize() != 0;
+  options.Optimization.Energy = f->GetEnergy() == 1 ? sdfcage::CageEnergy::Spacing : sdfcage::CageEnergy::MIPS;
+  options.Optimization.TargetSpacing = f->GetTargetSpacing();
+  options.Optimization.BarrierWeight = f->GetBarrierWeight();
+  options.Optimization.BarrierDistance = f->GetBarrierDistance();
+  options.Optimization.NumberOfIterations = f->GetNumberOfIterations();
+  options.Optimization.EdgeFlips = f->GetEdgeFlips() != 0;
+  return options;
+}
+
+std::string OrNoReason(const std::string& message)
+{
+  return message.empty() ? std::string("no reason given") : message;
+}
+} // namespace
 
 //------------------------------------------------------------------------------
 int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
@@ -140,242 +160,169 @@ int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
   envelopeOutput->Initialize();
   fieldOutput->Initialize();
 
-  // Publishes the results as field data on the cage (for ParaView's Information panel and
-  // pvpython's Fetch), whatever the outcome.
-  auto publish = [&]() {
-    vtkFieldData* fd = cageOutput->GetFieldData();
-    AddFieldValue<vtkDoubleArray>(fd, "ValidationTime", this->ValidationTime);
-    AddFieldValue<vtkDoubleArray>(fd, "DistanceFieldTime", this->DistanceFieldTime);
-    AddFieldValue<vtkDoubleArray>(fd, "IsosurfaceTime", this->IsosurfaceTime);
-    AddFieldValue<vtkDoubleArray>(fd, "VerificationTime", this->VerificationTime);
-    AddFieldValue<vtkDoubleArray>(fd, "SimplificationTime", this->SimplificationTime);
-    AddFieldValue<vtkDoubleArray>(fd, "CageVerificationTime", this->CageVerificationTime);
-    AddFieldValue<vtkDoubleArray>(fd, "TotalTime", this->TotalTime);
-    if (this->Optimize)
-    {
-      AddFieldValue<vtkDoubleArray>(fd, "EnergyBefore", this->EnergyBefore);
-      AddFieldValue<vtkDoubleArray>(fd, "EnergyAfter", this->EnergyAfter);
-      AddFieldValue<vtkDoubleArray>(fd, "OptimizationTime", this->OptimizationTime);
-    }
-    AddFieldValue<vtkIntArray>(fd, "VerticesReached", this->VerticesReached);
-    AddFieldValue<vtkIntArray>(fd, "TargetReached", this->TargetReached ? 1 : 0);
-    AddFieldValue<vtkStringArray>(fd, "StopReason", this->StopReason);
-    AddFieldValue<vtkDoubleArray>(fd, "MeasuredClearance", this->MeasuredClearance);
-    AddFieldValue<vtkDoubleArray>(
-      fd, "MeasuredClearanceRelative", this->MeasuredClearanceRelative);
-    AddFieldValue<vtkIntArray>(fd, "EnclosureVerified", this->EnclosureVerified ? 1 : 0);
-    AddFieldValue<vtkIntArray>(fd, "RemovedPockets", this->RemovedPockets);
-    AddFieldValue<vtkIntArray>(fd, "EnvelopeGenus", this->EnvelopeGenus);
-    AddFieldValue<vtkIntArray>(fd, "EnvelopeComponents", this->EnvelopeComponents);
-    AddFieldValue<vtkDoubleArray>(fd, "VoxelSizeUsed", this->VoxelSizeUsed);
-    AddFieldValue<vtkIntArray>(fd, "InputWasFlipped", this->InputWasFlipped ? 1 : 0);
-    AddFieldValue<vtkIdTypeArray>(fd, "NumberOfActivePoints", this->NumberOfActivePoints);
-    AddFieldValue<vtkDoubleArray>(fd, "ActivePointTime", this->ActivePointTime);
-    AddFieldValue<vtkStringArray>(fd, "TopologyWarning", this->TopologyWarning);
-    for (const auto& kv : this->ResultNumbers)
-    {
-      AddFieldValue<vtkDoubleArray>(fd, kv.first.c_str(), kv.second);
-    }
-    for (const auto& kv : this->ResultTexts)
-    {
-      AddFieldValue<vtkStringArray>(fd, kv.first.c_str(), kv.second);
-    }
-    AddFieldValue<vtkStringArray>(fd, "Status", this->StatusString);
-    AddFieldValue<vtkStringArray>(fd, "LastErrorMessage", this->LastErrorMessage);
-  };
-  auto fail = [&](const std::string& status, const std::string& message) {
-    this->StatusString = status;
-    this->LastErrorMessage = message;
-    vtkErrorMacro(<< message);
-    publish();
-    return 0;
-  };
-
-  // Empty input is not an error.
-  if (!input || input->GetNumberOfPoints() == 0 || input->GetNumberOfCells() == 0)
+  if (!input || input->GetNumberOfPoints() == 0 || input->GetNumberOfCells() == 0 ||
+    input->GetNumberOfPolys() + input->GetNumberOfStrips() == 0)
   {
-    this->StatusString = StatusIdentifier(sdfcage::Status::EmptyInput);
-    publish();
-    return 1;
+    return this->RejectInput(input, cageOutput);
   }
-  if (input->GetNumberOfPolys() + input->GetNumberOfStrips() == 0)
-  {
-    std::ostringstream msg;
-    msg << "The input has " << input->GetNumberOfVerts() << " vertex and "
-        << input->GetNumberOfLines()
-        << " line cells but no polygons: a surface mesh is required (for a point cloud, "
-           "reconstruct a surface first, e.g. with vtkSurfaceReconstructionFilter or ParaView's "
-           "Delaunay 3D + Extract Surface).";
-    return fail(StatusIdentifier(sdfcage::Status::InvalidInput), msg.str());
-  }
-
   try
   {
+    // read -> options -> run -> results -> outputs
     sdfcage::PolygonMesh mesh;
     ToPolygonMesh(input, mesh);
-
-    sdfcage::CageOptions options;
-    options.TargetNumberOfVertices = this->TargetNumberOfVertices;
-    options.Envelope.IsoValue = this->IsoValue;
-    options.Envelope.VoxelSize = this->VoxelSize;
-    options.Envelope.MinimumClearance = this->MinimumClearance;
-    options.Envelope.Adaptivity = this->Adaptivity;
-    options.Envelope.MaximumRefinements = this->MaximumRefinements;
-    options.Envelope.KeepDistanceField = this->GenerateDistanceField != 0;
-    options.Envelope.UseActivePoints = this->UseActivePoints != 0;
-    options.Envelope.ActivePoints.Radius = this->ActiveRadius;
-    options.Envelope.ActivePoints.GeodesicThreshold = this->GeodesicThreshold;
-    options.Envelope.ActivePoints.Alpha = this->AmplificationAlpha;
-    options.Envelope.ActivePoints.Beta = this->AmplificationBeta;
-    options.Envelope.NumberOfThreads = this->NumberOfThreads;
-    options.Envelope.Sign = static_cast<sdfcage::SignMode>(this->SignMode);
-    options.Optimize = this->Optimize != 0;
-    options.Optimization.Energy = this->Energy == 1 ? sdfcage::CageEnergy::Spacing : sdfcage::CageEnergy::MIPS;
-    options.Optimization.TargetSpacing = this->TargetSpacing;
-    options.Optimization.BarrierWeight = this->BarrierWeight;
-    options.Optimization.BarrierDistance = this->BarrierDistance;
-    options.Optimization.NumberOfIterations = this->NumberOfIterations;
-    options.Optimization.EdgeFlips = this->EdgeFlips != 0;
-
+    const sdfcage::CageOptions options = CageOptionsOf(this);
     FilterProgress progress(this);
     this->UpdateProgress(0.0);
     const sdfcage::CageResult result = sdfcage::generateCage(mesh, options, &progress);
-
-    this->ValidationTime = result.ValidationSeconds;
-    this->DistanceFieldTime = result.DistanceFieldSeconds;
-    this->IsosurfaceTime = result.IsosurfaceSeconds;
-    this->VerificationTime = result.VerificationSeconds;
-    this->SimplificationTime = result.SimplificationSeconds;
-    this->CageVerificationTime = result.CageVerificationSeconds;
-    this->TotalTime = result.TotalSeconds;
-    this->EnergyBefore = result.Optimization.EnergyBefore;
-    this->EnergyAfter = result.Optimization.EnergyAfter;
-    this->OptimizationTime = result.OptimizationSeconds;
-    this->VerticesReached = result.VerticesReached;
-    this->TargetReached = result.TargetReached;
-    this->StopReason = result.StopReason;
-    this->MeasuredClearance = result.MinimumClearance;
-    this->MeasuredClearanceRelative = result.MinimumClearanceRelative;
-    this->EnclosureVerified = result.EnclosureVerified;
-    this->RemovedPockets = result.RemovedPockets;
-    this->EnvelopeGenus = result.EnvelopeGenus;
-    this->EnvelopeComponents = result.EnvelopeComponents;
-    this->VoxelSizeUsed = result.VoxelSizeUsed;
-    this->InputWasFlipped = result.Defects.FlippedOrientation;
-    this->NumberOfActivePoints = static_cast<vtkIdType>(result.NumberOfActivePoints);
-    this->ActivePointTime = result.ActivePointSeconds;
-    this->TopologyWarning = result.TopologyWarning;
-    for (const sdfcage::ResultField& f : sdfcage::inputResults(result))
-    {
-      if (f.Type == sdfcage::ResultField::Kind::Text)
-        this->ResultTexts[f.Name] = f.Text;
-      else
-        this->ResultNumbers[f.Name] = f.number();
-    }
+    this->Internals->Results = sdfcage::cageResults(result);
     this->StatusString = StatusIdentifier(result.State);
     this->LastErrorMessage = result.Message;
-
-    switch (result.State)
-    {
-      case sdfcage::Status::Ok:
-        break;
-      case sdfcage::Status::EmptyInput:
-        // e.g. every polygon was a vertex or line cell: nothing to enclose, not an error.
-        publish();
-        return 1;
-      case sdfcage::Status::Cancelled:
-        // Aborted by the user, no error. A cancel during the simplification leaves a verified,
-        // valid cage (with more vertices than asked): output it; before that there is none.
-        vtkDebugMacro("Execution cancelled: " << result.Message);
-        if (!result.Cage.empty())
-        {
-          ToPolyData(result.Cage, result.CageDistanceToInput, cageOutput);
-          ToPolyData(result.Envelope, result.EnvelopeDistanceToInput, envelopeOutput);
-        }
-        publish();
-        return 1;
-      case sdfcage::Status::InvalidInput:
-      {
-        std::string message = result.Message;
-        if (message.empty())
-        {
-          message = result.Defects.errorMessage();
-        }
-        return fail(this->StatusString, message);
-      }
-      case sdfcage::Status::VerificationFailed:
-        // Keep the unverified envelope for inspection; the cage stays empty.
-        ToPolyData(result.Envelope, result.EnvelopeDistanceToInput, envelopeOutput);
-        return fail(this->StatusString,
-          "The envelope could not be verified: " +
-            (result.Message.empty() ? std::string("no reason given") : result.Message));
-      case sdfcage::Status::Failed:
-      default:
-        return fail(this->StatusString,
-          "Cage generation failed: " +
-            (result.Message.empty() ? std::string("no reason given") : result.Message));
-    }
-
-    std::vector<std::string> warnings = result.Defects.warnings();
-    if (this->Optimize && !result.Optimized && result.State == sdfcage::Status::Ok)
-    {
-      warnings.push_back("the cage was not optimized: " +
-        (result.Optimization.Message.empty() ? std::string("no reason given") : result.Optimization.Message));
-    }
-    if (!result.TargetReached)
-    {
-      std::ostringstream msg;
-      msg << "the cage has " << result.VerticesReached << " vertices, not the " << this->TargetNumberOfVertices
-          << " asked for: " << (result.StopReason.empty() ? "no reason given" : result.StopReason);
-      warnings.push_back(msg.str());
-    }
-    if (!result.TopologyWarning.empty())
-    {
-      warnings.push_back(result.TopologyWarning);
-    }
-    if (!warnings.empty())
-    {
-      std::ostringstream msg;
-      for (std::size_t i = 0; i < warnings.size(); ++i)
-      {
-        msg << (i ? "; " : "") << warnings[i];
-      }
-      vtkWarningMacro(<< msg.str());
-    }
-
-    ToPolyData(result.Cage, result.CageDistanceToInput, cageOutput);
-    ToPolyData(result.Envelope, result.EnvelopeDistanceToInput, envelopeOutput);
-    if (this->GenerateDistanceField)
-    {
-      ToImageData(result.DistanceField, fieldOutput, "SignedDistance");
-      ToImageData(result.ModifiedDistanceField, fieldOutput, "ModifiedSignedDistance");
-    }
-    publish();
-    this->UpdateProgress(1.0);
-    return 1;
+    return this->DeliverOutputs(result, cageOutput, envelopeOutput, fieldOutput);
   }
   catch (const std::bad_alloc&)
   {
-    cageOutput->Initialize();
     envelopeOutput->Initialize();
     fieldOutput->Initialize();
-    return fail(StatusIdentifier(sdfcage::Status::Failed),
-      "Out of memory. Use a larger VoxelSize (or IsoValue), or turn GenerateDistanceField off.");
+    return this->Fail(StatusIdentifier(sdfcage::Status::Failed),
+      "Out of memory. Use a larger VoxelSize (or IsoValue), or turn GenerateDistanceField off.", cageOutput);
   }
   catch (const std::exception& e)
   {
-    cageOutput->Initialize();
     envelopeOutput->Initialize();
     fieldOutput->Initialize();
-    return fail(StatusIdentifier(sdfcage::Status::Failed), std::string("Cage generation failed: ") + e.what());
+    return this->Fail(
+      StatusIdentifier(sdfcage::Status::Failed), std::string("Cage generation failed: ") + e.what(), cageOutput);
   }
   catch (...)
   {
-    cageOutput->Initialize();
     envelopeOutput->Initialize();
     fieldOutput->Initialize();
-    return fail(StatusIdentifier(sdfcage::Status::Failed), "Cage generation failed with an unknown exception.");
+    return this->Fail(
+      StatusIdentifier(sdfcage::Status::Failed), "Cage generation failed with an unknown exception.", cageOutput);
   }
+}
+
+//------------------------------------------------------------------------------
+// No input, or nothing that could be a surface: empty input is not an error, points and lines
+// without polygons are.
+int vtkSDFCageFilter::RejectInput(vtkPolyData* input, vtkPolyData* cage)
+{
+  if (!input || input->GetNumberOfPoints() == 0 || input->GetNumberOfCells() == 0)
+  {
+    this->StatusString = StatusIdentifier(sdfcage::Status::EmptyInput);
+    this->PublishResults(cage);
+    return 1;
+  }
+  std::ostringstream msg;
+  msg << "The input has " << input->GetNumberOfVerts() << " vertex and " << input->GetNumberOfLines()
+      << " line cells but no polygons: a surface mesh is required (for a point cloud, "
+         "reconstruct a surface first, e.g. with vtkSurfaceReconstructionFilter or ParaView's "
+         "Delaunay 3D + Extract Surface).";
+  return this->Fail(StatusIdentifier(sdfcage::Status::InvalidInput), msg.str(), cage);
+}
+
+//------------------------------------------------------------------------------
+int vtkSDFCageFilter::Fail(const std::string& status, const std::string& message, vtkPolyData* cage)
+{
+  cage->Initialize();
+  this->StatusString = status;
+  this->LastErrorMessage = message;
+  vtkErrorMacro(<< message);
+  this->PublishResults(cage);
+  return 0;
+}
+
+//------------------------------------------------------------------------------
+// The outputs for each outcome of Core's run; the results are already stored.
+int vtkSDFCageFilter::DeliverOutputs(
+  const sdfcage::CageResult& result, vtkPolyData* cage, vtkPolyData* envelope, vtkImageData* field)
+{
+  switch (result.State)
+  {
+    case sdfcage::Status::Ok:
+      break;
+    case sdfcage::Status::EmptyInput:
+      // e.g. every polygon was a vertex or line cell: nothing to enclose, not an error.
+      this->PublishResults(cage);
+      return 1;
+    case sdfcage::Status::Cancelled:
+      // Aborted by the user, no error. A cancel during the simplification leaves a verified,
+      // valid cage (with more vertices than asked): output it; before that there is none.
+      vtkDebugMacro("Execution cancelled: " << result.Message);
+      if (!result.Cage.empty())
+      {
+        ToPolyData(result.Cage, result.CageDistanceToInput, cage);
+        ToPolyData(result.Envelope, result.EnvelopeDistanceToInput, envelope);
+      }
+      this->PublishResults(cage);
+      return 1;
+    case sdfcage::Status::InvalidInput:
+      return this->Fail(
+        this->StatusString, result.Message.empty() ? result.Defects.errorMessage() : result.Message, cage);
+    case sdfcage::Status::VerificationFailed:
+      // Keep the unverified envelope for inspection; the cage stays empty.
+      ToPolyData(result.Envelope, result.EnvelopeDistanceToInput, envelope);
+      return this->Fail(
+        this->StatusString, "The envelope could not be verified: " + OrNoReason(result.Message), cage);
+    case sdfcage::Status::Failed:
+    default:
+      return this->Fail(this->StatusString, "Cage generation failed: " + OrNoReason(result.Message), cage);
+  }
+
+  this->WarnAbout(result);
+  ToPolyData(result.Cage, result.CageDistanceToInput, cage);
+  ToPolyData(result.Envelope, result.EnvelopeDistanceToInput, envelope);
+  if (this->GenerateDistanceField)
+  {
+    ToImageData(result.DistanceField, field, "SignedDistance");
+    ToImageData(result.ModifiedDistanceField, field, "ModifiedSignedDistance");
+  }
+  this->PublishResults(cage);
+  this->UpdateProgress(1.0);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+// One warning for everything a successful run should tell: repairs of the input, an optimization
+// that did not happen, a target not reached, fused parts.
+void vtkSDFCageFilter::WarnAbout(const sdfcage::CageResult& result)
+{
+  std::vector<std::string> warnings = result.Defects.warnings();
+  if (this->Optimize && !result.Optimized && result.State == sdfcage::Status::Ok)
+  {
+    warnings.push_back("the cage was not optimized: " + OrNoReason(result.Optimization.Message));
+  }
+  if (!result.TargetReached)
+  {
+    std::ostringstream msg;
+    msg << "the cage has " << result.VerticesReached << " vertices, not the " << this->TargetNumberOfVertices
+        << " asked for: " << OrNoReason(result.StopReason);
+    warnings.push_back(msg.str());
+  }
+  if (!result.TopologyWarning.empty())
+  {
+    warnings.push_back(result.TopologyWarning);
+  }
+  if (!warnings.empty())
+  {
+    std::ostringstream msg;
+    for (std::size_t i = 0; i < warnings.size(); ++i)
+    {
+      msg << (i ? "; " : "") << warnings[i];
+    }
+    vtkWarningMacro(<< msg.str());
+  }
+}
+
+//------------------------------------------------------------------------------
+// The results as field data of the cage (for ParaView's Information panel and pvpython's Fetch),
+// whatever the outcome.
+void vtkSDFCageFilter::PublishResults(vtkPolyData* cage) const
+{
+  vtkFieldData* fd = cage->GetFieldData();
+  AddResultArrays(fd, this->Internals->Results);
+  AddFieldValue<vtkStringArray>(fd, "Status", this->StatusString);
+  AddFieldValue<vtkStringArray>(fd, "LastErrorMessage", this->LastErrorMessage);
 }
 
 //------------------------------------------------------------------------------
@@ -393,8 +340,6 @@ void vtkSDFCageFilter::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "GeodesicThreshold: " << this->GeodesicThreshold << "\n";
   os << indent << "AmplificationAlpha: " << this->AmplificationAlpha << "\n";
   os << indent << "AmplificationBeta: " << this->AmplificationBeta << "\n";
-  os << indent << "NumberOfActivePoints: " << this->NumberOfActivePoints << "\n";
-  os << indent << "TopologyWarning: " << this->TopologyWarning << "\n";
   os << indent << "SignMode: " << this->SignMode << "\n";
   os << indent << "GenerateDistanceField: " << (this->GenerateDistanceField ? "On" : "Off")
      << "\n";
@@ -408,36 +353,39 @@ void vtkSDFCageFilter::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "EdgeFlips: " << (this->EdgeFlips ? "On" : "Off") << "\n";
   os << indent << "Status: " << this->StatusString << "\n";
   os << indent << "LastErrorMessage: " << this->LastErrorMessage << "\n";
-  os << indent << "ValidationTime: " << this->ValidationTime << "\n";
-  os << indent << "DistanceFieldTime: " << this->DistanceFieldTime << "\n";
-  os << indent << "IsosurfaceTime: " << this->IsosurfaceTime << "\n";
-  os << indent << "VerificationTime: " << this->VerificationTime << "\n";
-  os << indent << "SimplificationTime: " << this->SimplificationTime << "\n";
-  os << indent << "CageVerificationTime: " << this->CageVerificationTime << "\n";
-  os << indent << "TotalTime: " << this->TotalTime << "\n";
-  os << indent << "VerticesReached: " << this->VerticesReached << "\n";
-  os << indent << "TargetReached: " << this->TargetReached << "\n";
-  os << indent << "StopReason: " << this->StopReason << "\n";
-  os << indent << "MeasuredClearance: " << this->MeasuredClearance << "\n";
-  os << indent << "MeasuredClearanceRelative: " << this->MeasuredClearanceRelative << "\n";
-  os << indent << "EnclosureVerified: " << this->EnclosureVerified << "\n";
-  os << indent << "RemovedPockets: " << this->RemovedPockets << "\n";
-  os << indent << "EnvelopeGenus: " << this->EnvelopeGenus << "\n";
-  os << indent << "EnvelopeComponents: " << this->EnvelopeComponents << "\n";
-  os << indent << "VoxelSizeUsed: " << this->VoxelSizeUsed << "\n";
-  os << indent << "InputWasFlipped: " << this->InputWasFlipped << "\n";
+  for (const sdfcage::ResultField& f : this->Internals->Results)
+  {
+    os << indent << f.Name << ": " << f.toString() << "\n";
+  }
 }
 
 //------------------------------------------------------------------------------
 double vtkSDFCageFilter::GetResultNumber(const char* name) const
 {
-  const auto it = name ? this->ResultNumbers.find(name) : this->ResultNumbers.end();
-  return it == this->ResultNumbers.end() ? 0.0 : it->second;
+  return ResultNumber(this->Internals->Results, name);
+}
+
+//------------------------------------------------------------------------------
+long long vtkSDFCageFilter::ResultInteger(const char* name) const
+{
+  const sdfcage::ResultField* f = name ? sdfcage::findResult(this->Internals->Results, name) : nullptr;
+  return f ? f->Integer : 0;
 }
 
 //------------------------------------------------------------------------------
 const char* vtkSDFCageFilter::GetResultText(const char* name) const
 {
-  const auto it = name ? this->ResultTexts.find(name) : this->ResultTexts.end();
-  return it == this->ResultTexts.end() ? "" : it->second.c_str();
+  return ResultText(this->Internals->Results, name);
+}
+
+//------------------------------------------------------------------------------
+int vtkSDFCageFilter::GetNumberOfResults() const
+{
+  return static_cast<int>(this->Internals->Results.size());
+}
+
+//------------------------------------------------------------------------------
+const char* vtkSDFCageFilter::GetResultName(int index) const
+{
+  return ResultName(this->Internals->Results, index);
 }

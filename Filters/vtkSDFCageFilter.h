@@ -23,14 +23,19 @@
  * Optional optimization stage (§3.3, Optimize off by default): vertex relocation and edge flips
  * lower a MIPS or cage-spacing energy while every guarantee is kept (see vtkCageOptimizeFilter).
  *
- * The input must be a closed (watertight), manifold, consistently oriented surface: polygons and
- * triangle strips are triangulated, vertex and line cells are ignored, an inward-oriented mesh is
- * flipped (with a warning). Several components are allowed.
+ * Any surface is accepted: polygons and triangle strips are triangulated, coincident points
+ * merged, degenerate and duplicated triangles dropped, vertex and line cells ignored, a closed
+ * inward-oriented mesh flipped (with a warning). A closed, consistently oriented 2-manifold keeps
+ * the flood-fill inside; open, non-manifold or inconsistently oriented inputs are signed by their
+ * winding number (see SignMode). Several components are allowed.
  *
  * Outputs:
  * - port 0 ("Cage"): the cage, with point array `DistanceToInput` (double, input units) and
- *   field data holding the results listed below (one-tuple arrays named like the getters, plus
- *   the string arrays `Status`, `LastErrorMessage` and `StopReason`).
+ *   field data holding every result of the run (Core's results table, sdfcage::cageResults): one
+ *   one-tuple array per result, named like its getter (flags as int 0/1, counts as vtkIdType,
+ *   measures as double, texts as strings), plus the string arrays `Status` and
+ *   `LastErrorMessage`. GetResultNumber / GetResultText read any result by name, and
+ *   GetNumberOfResults / GetResultName list them.
  * - port 1 ("Envelope"): the verified dense envelope, with point array `DistanceToInput`.
  * - port 2 ("Distance Field"): a vtkImageData with the sampled signed distance as point array
  *   `SignedDistance` (input units; negative inside, positive outside) when GenerateDistanceField
@@ -49,9 +54,9 @@
  * envelope are output. VTK 9.1 clears the abort flag when the next execution starts; the VTK
  * bundled with ParaView 5.11 keeps it set until SetAbortExecute(0).
  *
- * @warning The input must be closed: an open, non-manifold or degenerate input is rejected with
- * an error that names the defect and its count (e.g. "the mesh has 12 boundary edges ...") and
- * all outputs are empty. Self-intersecting inputs are not detected. If the envelope or the cage
+ * @warning An input without polygons, with non-finite points or invalid point ids is rejected
+ * with an error that names the defect, and all outputs are empty. Self-intersecting inputs are not
+ * detected. If the envelope or the cage
  * cannot be verified, that is an error too: the cage output stays empty and the envelope (if
  * any) is put on port 1 so the failure can be inspected. If the simplification cannot reach
  * TargetNumberOfVertices (no feasible collapse left), the cage it reached is output with a warning
@@ -70,8 +75,15 @@
 #include "SDFCageFiltersModule.h" // For export macro
 #include "vtkPolyDataAlgorithm.h"
 
-#include <map>    // For the results by name
+#include <memory> // For the results table
 #include <string> // For the status strings
+
+namespace sdfcage
+{
+struct CageResult;
+}
+
+class vtkImageData;
 
 class SDFCAGEFILTERS_EXPORT vtkSDFCageFilter : public vtkPolyDataAlgorithm
 {
@@ -148,15 +160,21 @@ public:
 
   ///@{
   /**
-   * Results of the last execution by name, as in the field data of the cage: what was done to
-   * the input (MergedPoints, MergeTolerance, TriangulatedPolygons, DroppedDegenerateTriangles,
+   * Every result of the last execution by name, as in the field data of the cage (Core's
+   * results table, sdfcage::cageResults, in its order): the verdict (EnclosureVerified,
+   * MeasuredClearance, VerticesReached, TargetReached, StopReason), the envelope, the
+   * simplification's and the optimization's statistics, the timings, what was done to the input
+   * (MergedPoints, MergeTolerance, TriangulatedPolygons, DroppedDegenerateTriangles,
    * DroppedDuplicateTriangles, IgnoredCells), what it is (InputBoundaryEdges,
    * InputNonManifoldEdges, InputNonManifoldVertices, InputInconsistentEdges, InputComponents,
    * InputClosed, InputGenus: -1 when undefined) and how its inside was decided (SignMode,
-   * SignReason, WindingTime). GetResultNumber gives 0 and GetResultText "" for unknown names.
+   * SignReason, WindingTime). The getters below read the same table. GetResultNumber gives flags
+   * as 0/1, 0 for texts and unknown names; GetResultText gives "" for numbers and unknown names.
    */
   double GetResultNumber(const char* name) const;
   const char* GetResultText(const char* name) const;
+  int GetNumberOfResults() const;
+  const char* GetResultName(int index) const; ///< "" out of range
   ///@}
 
   ///@{
@@ -199,9 +217,9 @@ public:
    * active, its time in seconds, and a warning (empty when the envelope has the input's genus
    * and component count).
    */
-  vtkGetMacro(NumberOfActivePoints, vtkIdType);
-  vtkGetMacro(ActivePointTime, double);
-  const char* GetTopologyWarning() const { return this->TopologyWarning.c_str(); }
+  vtkIdType GetNumberOfActivePoints() const { return this->ResultInteger("NumberOfActivePoints"); }
+  double GetActivePointTime() const { return this->GetResultNumber("ActivePointTime"); }
+  const char* GetTopologyWarning() const { return this->GetResultText("TopologyWarning"); }
   ///@}
 
   ///@{
@@ -256,9 +274,9 @@ public:
    * Optimization results (only valid after the filter has executed with Optimize on): E_quality
    * before and after (see vtkCageOptimizeFilter) and the time in seconds.
    */
-  vtkGetMacro(EnergyBefore, double);
-  vtkGetMacro(EnergyAfter, double);
-  vtkGetMacro(OptimizationTime, double);
+  double GetEnergyBefore() const { return this->GetResultNumber("EnergyBefore"); }
+  double GetEnergyAfter() const { return this->GetResultNumber("EnergyAfter"); }
+  double GetOptimizationTime() const { return this->GetResultNumber("OptimizationTime"); }
   ///@}
 
   ///@{
@@ -267,13 +285,13 @@ public:
    * input validation, distance field, isosurface, envelope verification, simplification, final
    * cage verification, and the whole run.
    */
-  vtkGetMacro(ValidationTime, double);
-  vtkGetMacro(DistanceFieldTime, double);
-  vtkGetMacro(IsosurfaceTime, double);
-  vtkGetMacro(VerificationTime, double);
-  vtkGetMacro(SimplificationTime, double);
-  vtkGetMacro(CageVerificationTime, double);
-  vtkGetMacro(TotalTime, double);
+  double GetValidationTime() const { return this->GetResultNumber("ValidationTime"); }
+  double GetDistanceFieldTime() const { return this->GetResultNumber("DistanceFieldTime"); }
+  double GetIsosurfaceTime() const { return this->GetResultNumber("IsosurfaceTime"); }
+  double GetVerificationTime() const { return this->GetResultNumber("VerificationTime"); }
+  double GetSimplificationTime() const { return this->GetResultNumber("SimplificationTime"); }
+  double GetCageVerificationTime() const { return this->GetResultNumber("CageVerificationTime"); }
+  double GetTotalTime() const { return this->GetResultNumber("TotalTime"); }
   ///@}
 
   ///@{
@@ -282,9 +300,9 @@ public:
    * vertices reached, whether it equals TargetNumberOfVertices, and why the simplification stopped
    * early (empty when the target was reached).
    */
-  vtkGetMacro(VerticesReached, int);
-  vtkGetMacro(TargetReached, bool);
-  const char* GetStopReason() const { return this->StopReason.c_str(); }
+  int GetVerticesReached() const { return static_cast<int>(this->ResultInteger("VerticesReached")); }
+  bool GetTargetReached() const { return this->ResultInteger("TargetReached") != 0; }
+  const char* GetStopReason() const { return this->GetResultText("StopReason"); }
   ///@}
 
   ///@{
@@ -293,8 +311,8 @@ public:
    * distance), in input units and relative to the unit sphere (only valid after the filter has
    * executed).
    */
-  vtkGetMacro(MeasuredClearance, double);
-  vtkGetMacro(MeasuredClearanceRelative, double);
+  double GetMeasuredClearance() const { return this->GetResultNumber("MeasuredClearance"); }
+  double GetMeasuredClearanceRelative() const { return this->GetResultNumber("MeasuredClearanceRelative"); }
   ///@}
 
   ///@{
@@ -304,12 +322,12 @@ public:
    * number of components of the envelope, the voxel size actually used (relative, after
    * refinements), and whether the input was inward-oriented and had to be flipped.
    */
-  vtkGetMacro(EnclosureVerified, bool);
-  vtkGetMacro(RemovedPockets, int);
-  vtkGetMacro(EnvelopeGenus, int);
-  vtkGetMacro(EnvelopeComponents, int);
-  vtkGetMacro(VoxelSizeUsed, double);
-  vtkGetMacro(InputWasFlipped, bool);
+  bool GetEnclosureVerified() const { return this->ResultInteger("EnclosureVerified") != 0; }
+  int GetRemovedPockets() const { return static_cast<int>(this->ResultInteger("RemovedPockets")); }
+  int GetEnvelopeGenus() const { return static_cast<int>(this->ResultInteger("EnvelopeGenus")); }
+  int GetEnvelopeComponents() const { return static_cast<int>(this->ResultInteger("EnvelopeComponents")); }
+  double GetVoxelSizeUsed() const { return this->GetResultNumber("VoxelSizeUsed"); }
+  bool GetInputWasFlipped() const { return this->ResultInteger("InputWasFlipped") != 0; }
   ///@}
 
   /**
@@ -353,33 +371,7 @@ protected:
   vtkTypeBool EdgeFlips;
   int SignMode = 0;
 
-  // results of the last execution
-  double ValidationTime = 0.0;
-  double DistanceFieldTime = 0.0;
-  double IsosurfaceTime = 0.0;
-  double VerificationTime = 0.0;
-  double SimplificationTime = 0.0;
-  double CageVerificationTime = 0.0;
-  double TotalTime = 0.0;
-  double EnergyBefore = 0.0;
-  double EnergyAfter = 0.0;
-  double OptimizationTime = 0.0;
-  int VerticesReached = 0;
-  bool TargetReached = false;
-  std::string StopReason;
-  double MeasuredClearance = 0.0;
-  double MeasuredClearanceRelative = 0.0;
-  bool EnclosureVerified = false;
-  int RemovedPockets = 0;
-  int EnvelopeGenus = 0;
-  int EnvelopeComponents = 0;
-  double VoxelSizeUsed = 0.0;
-  bool InputWasFlipped = false;
-  vtkIdType NumberOfActivePoints = 0;
-  std::map<std::string, double> ResultNumbers; // the table results (Core's inputResults)
-  std::map<std::string, std::string> ResultTexts;
-  double ActivePointTime = 0.0;
-  std::string TopologyWarning;
+  // outcome of the last execution (the results are in Internals' table)
   std::string StatusString;
   std::string LastErrorMessage;
 
@@ -387,7 +379,18 @@ private:
   vtkSDFCageFilter(const vtkSDFCageFilter&) = delete;
   void operator=(const vtkSDFCageFilter&) = delete;
 
+  // the phases of RequestData
   void ResetResults();
+  int RejectInput(vtkPolyData* input, vtkPolyData* cage);
+  int Fail(const std::string& status, const std::string& message, vtkPolyData* cage);
+  int DeliverOutputs(const sdfcage::CageResult& result, vtkPolyData* cage, vtkPolyData* envelope,
+    vtkImageData* field);
+  void WarnAbout(const sdfcage::CageResult& result);
+  void PublishResults(vtkPolyData* cage) const;
+  long long ResultInteger(const char* name) const;
+
+  struct vtkInternals;
+  std::unique_ptr<vtkInternals> Internals;
 };
 
 #endif

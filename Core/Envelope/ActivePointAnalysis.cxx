@@ -3,8 +3,7 @@
 #include "Pipeline/CageGenerator.h"
 #include "Envelope/SDFIsosurface.h"
 #include "Common/Progress.h"
-
-#include <tbb/global_control.h>
+#include "Common/Threads.h"
 
 #include <chrono>
 #include <memory>
@@ -18,12 +17,7 @@ ActivePointAnalysis analyzeActivePoints(
   ActivePointAnalysis result;
   const auto start = std::chrono::steady_clock::now();
   auto elapsed = [&]() { return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(); };
-  std::unique_ptr<tbb::global_control> threads;
-  if (options.NumberOfThreads > 0)
-  {
-    threads = std::make_unique<tbb::global_control>(
-      tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(options.NumberOfThreads));
-  }
+  const ThreadLimit threads(options.NumberOfThreads);
   const std::string bad = options.ActivePoints.validate();
   if (!bad.empty())
   {

@@ -18,6 +18,7 @@ struct ActivePointAnalysisOptions
   bool GenerateFields = false;
   /// Isovalue c, only to size the display grid's margin (unit-sphere units).
   double IsoValue = 0.01;
+  /// Worker threads (0 = all cores), as CageOptions::NumberOfThreads.
   int NumberOfThreads = 0;
 };
 

@@ -69,8 +69,6 @@ struct EnvelopeOptions
   ActivePointOptions ActivePoints;
   /// Keep the sampled SDF as a dense image (for display).
   bool KeepDistanceField = false;
-  /// Worker threads (0 = all cores).
-  int NumberOfThreads = 0;
 
   double voxelSize() const { return VoxelSize > 0 ? VoxelSize : IsoValue / 2; }
   double clearance() const { return MinimumClearance > 0 ? MinimumClearance : IsoValue / 4; }

@@ -1,10 +1,9 @@
 #include "Pipeline/CageGenerator.h"
 
 #include "Common/Progress.h"
+#include "Common/Threads.h"
 #include "Quality/Verification.h"
 #include "Spatial/TriangleTree.h"
-
-#include <tbb/global_control.h>
 
 #include <algorithm>
 #include <chrono>
@@ -56,12 +55,7 @@ CageResult generateOnce(const PolygonMesh& input, const CageOptions& options, Pr
   CageResult result;
   result.IsoValueUsed = options.Envelope.IsoValue;
   const auto start = std::chrono::steady_clock::now();
-  std::unique_ptr<tbb::global_control> threads;
-  if (options.Envelope.NumberOfThreads > 0)
-  {
-    threads = std::make_unique<tbb::global_control>(
-      tbb::global_control::max_allowed_parallelism, static_cast<std::size_t>(options.Envelope.NumberOfThreads));
-  }
+  const ThreadLimit threads(options.NumberOfThreads);
 
   // 1. validation
   progressStage(progress, "validating input", 0.0, 0.02);
@@ -163,14 +157,14 @@ CageResult generateOnce(const PolygonMesh& input, const CageOptions& options, Pr
     const std::shared_ptr<const TriangleTree> ownTree = env.InputTree ? nullptr : std::make_shared<TriangleTree>(unit);
     const TriangleTree& tree = env.InputTree ? *env.InputTree : *ownTree;
     SimplifyOptions so = options.Simplify;
-    so.TargetVertices = options.TargetNumberOfVertices;
+    so.TargetNumberOfVertices = options.TargetNumberOfVertices;
     so.Clearance = options.Envelope.clearance();
     progressStage(progress, "simplifying", 0.45, 0.95);
     const std::vector<Vec3> probes = componentProbes(unit);
     result.Simplification = simplifyEnvelope(env.Envelope, tree, so, progress, &probes);
     result.SimplificationSeconds = result.Simplification.Seconds;
     result.VerticesReached = result.Simplification.VerticesReached;
-    result.TargetReached = result.Simplification.ReachedTarget;
+    result.TargetReached = result.Simplification.TargetReached;
     result.StopReason = result.Simplification.StopReason;
     // independent re-verification of the final cage (exact distances, winding numbers). It runs
     // even after a cancel: the partial cage is valid and usable.

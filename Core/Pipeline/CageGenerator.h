@@ -12,6 +12,8 @@ namespace sdfcage
 
 struct CageOptions
 {
+  /// Worker threads of every stage (0 = all cores). The cage does not depend on it.
+  int NumberOfThreads = 0;
   EnvelopeOptions Envelope;
   ValidationOptions Validation;
   /// Target vertex count of the cage; 0 keeps the dense verified envelope as the cage.
@@ -38,7 +40,13 @@ struct CageResult
 {
   Status State = Status::Failed;
   std::string Message;              ///< error or cancellation reason (empty when Ok)
-  MeshDefects Defects;              ///< validation report of the input
+  /// Validation report of the input; Empty until the input is validated (a run that did not
+  /// happen has no input: not closed, genus undefined).
+  MeshDefects Defects = [] {
+    MeshDefects none;
+    none.Empty = true;
+    return none;
+  }();
   TriangleMesh Cage;                ///< input coordinates
   std::vector<double> CageDistanceToInput; ///< per cage point, input units
   TriangleMesh Envelope;            ///< input coordinates

@@ -1,12 +1,74 @@
 #include "Pipeline/Results.h"
 
+#include "Envelope/ActivePointAnalysis.h"
 #include "Pipeline/CageGenerator.h"
+#include "Quality/CageQuality.h"
+
+#include <cstdio>
 
 namespace sdfcage
 {
 
+void ResultField::setNumber(double v)
+{
+  switch (Type)
+  {
+    case Kind::Flag:
+      Integer = v != 0.0 ? 1 : 0;
+      break;
+    case Kind::Integer:
+      Integer = static_cast<long long>(v);
+      break;
+    case Kind::Real:
+      Real = v;
+      break;
+    case Kind::Text:
+      break;
+  }
+}
+
+std::string ResultField::toString() const
+{
+  switch (Type)
+  {
+    case Kind::Flag:
+      return Integer ? "yes" : "no";
+    case Kind::Integer:
+      return std::to_string(Integer);
+    case Kind::Real:
+    {
+      char buffer[32];
+      std::snprintf(buffer, sizeof(buffer), "%.6g", Real);
+      return buffer;
+    }
+    case Kind::Text:
+      break;
+  }
+  return Text;
+}
+
+const ResultField* findResult(const ResultTable& table, const std::string& name)
+{
+  for (const ResultField& f : table)
+  {
+    if (f.Name == name)
+      return &f;
+  }
+  return nullptr;
+}
+
 namespace
 {
+// One row of a table: name, value, unit, description.
+ResultField flag(const char* name, bool v, const char* what)
+{
+  ResultField f;
+  f.Name = name;
+  f.Type = ResultField::Kind::Flag;
+  f.Integer = v ? 1 : 0;
+  f.Description = what;
+  return f;
+}
 ResultField integer(const char* name, long long v, const char* unit, const char* what)
 {
   ResultField f;
@@ -19,24 +81,89 @@ ResultField integer(const char* name, long long v, const char* unit, const char*
 }
 ResultField real(const char* name, double v, const char* unit, const char* what)
 {
-  ResultField f = integer(name, 0, unit, what);
+  ResultField f;
+  f.Name = name;
   f.Type = ResultField::Kind::Real;
   f.Real = v;
+  f.Unit = unit;
+  f.Description = what;
   return f;
 }
 ResultField text(const char* name, const std::string& v, const char* what)
 {
-  ResultField f = integer(name, 0, "", what);
+  ResultField f;
+  f.Name = name;
   f.Type = ResultField::Kind::Text;
   f.Text = v;
+  f.Description = what;
   return f;
+}
+
+void append(ResultTable& table, ResultTable rows)
+{
+  table.insert(table.end(), rows.begin(), rows.end());
+}
+
+// The optimization's statistics, shared by the cage run and the optimization filter.
+ResultTable optimizationStatistics(const OptimizeResult& o)
+{
+  return {
+    real("EnergyBefore", o.EnergyBefore, "", "optimization energy E_quality of the simplified cage"),
+    real("EnergyAfter", o.EnergyAfter, "", "optimization energy E_quality of the optimized cage"),
+    real("MinimumAngleBefore", o.MinimumAngleBefore, "degrees", "smallest triangle angle before the optimization"),
+    real("MinimumAngleAfter", o.MinimumAngleAfter, "degrees", "smallest triangle angle after the optimization"),
+    integer("NumberOfMoves", o.Moves, "count", "accepted vertex relocations"),
+    integer("NumberOfFlips", o.Flips, "count", "accepted edge flips"),
+    flag("Reverted", o.Reverted, "the optimized cage failed its verification: the given cage was kept"),
+    real("OptimizationTime", o.Seconds, "s", "optimization, verification included"),
+  };
 }
 } // namespace
 
-std::vector<ResultField> inputResults(const CageResult& r)
+ResultTable cageResults(const CageResult& r)
 {
   const MeshDefects& d = r.Defects;
-  return {
+  const SimplifyResult& s = r.Simplification;
+  ResultTable t = {
+    // the verdict
+    flag("EnclosureVerified", r.EnclosureVerified, "the cage strictly encloses the input with the clearance (verified)"),
+    real("MeasuredClearance", r.MinimumClearance, "input units", "minimum distance between the cage and the input (exact)"),
+    real("MeasuredClearanceRelative", r.MinimumClearanceRelative, "relative", "the same, for the input scaled into the unit sphere"),
+    integer("VerticesReached", r.VerticesReached, "count", "vertices of the cage"),
+    flag("TargetReached", r.TargetReached, "the cage has the number of vertices asked for (or no simplification was asked)"),
+    text("StopReason", r.StopReason, "why the simplification stopped before the target (empty when it reached it)"),
+    // the envelope (paper 3.1)
+    integer("RemovedPockets", r.RemovedPockets, "count", "trapped air pockets (inner envelope components) removed"),
+    integer("EnvelopeGenus", r.EnvelopeGenus, "", "genus of the envelope"),
+    integer("EnvelopeComponents", r.EnvelopeComponents, "count", "connected parts of the envelope"),
+    real("VoxelSizeUsed", r.VoxelSizeUsed, "relative", "voxel size of the distance grid, after any refinement"),
+    flag("InputWasFlipped", d.FlippedOrientation, "the input was inward-oriented and was flipped"),
+    integer("NumberOfActivePoints", static_cast<long long>(r.NumberOfActivePoints), "count", "input points found active (nearly touching another part)"),
+    integer("NumberOfActiveSamples", static_cast<long long>(r.NumberOfActiveSamples), "count", "samples of the active set A on the surface"),
+    text("TopologyWarning", r.TopologyWarning, "set when the envelope's genus or components differ from the input's"),
+    // the simplification (paper 3.2)
+    integer("Collapses", s.Collapses, "count", "edge collapses performed"),
+    integer("CollapsesRejectedByClearance", s.RejectedInput, "count", "candidate collapses vetoed by the clearance to the input"),
+    integer("CollapsesRejectedBySelfIntersection", s.RejectedSelf, "count", "... by a self-intersection or the self clearance"),
+    integer("CollapsesRejectedByTopology", s.RejectedTopology, "count", "... by the link condition"),
+    integer("CollapsesRejectedByShape", s.RejectedShape, "count", "... by a flip or a needle"),
+    integer("RelocatedPlacements", s.Relocated, "count", "infeasible placements replaced by a feasible one"),
+    // the optional optimization (paper 3.3)
+    flag("Optimized", r.Optimized, "the optimization ran and its result is the cage"),
+  };
+  append(t, optimizationStatistics(r.Optimization));
+  append(t, {
+    // timings
+    real("ValidationTime", r.ValidationSeconds, "s", "input validation and repair"),
+    real("DistanceFieldTime", r.DistanceFieldSeconds, "s", "distance field (sign and amplification included)"),
+    real("ActivePointTime", r.ActivePointSeconds, "s", "active points and their geodesic distances"),
+    real("AmplificationTime", r.AmplificationSeconds, "s", "amplified field phi xi on the grid (part of DistanceFieldTime)"),
+    real("IsosurfaceTime", r.IsosurfaceSeconds, "s", "isosurface extraction"),
+    real("VerificationTime", r.VerificationSeconds, "s", "envelope verification"),
+    real("SimplificationTime", r.SimplificationSeconds, "s", "constrained simplification"),
+    real("CageVerificationTime", r.CageVerificationSeconds, "s", "independent verification of the cage"),
+    real("TotalTime", r.TotalSeconds, "s", "the whole run"),
+    // what was done to the input, and how its inside was decided
     integer("MergedPoints", d.MergedPoints, "count", "coincident input points merged (split seams, duplicated positions)"),
     real("MergeTolerance", d.MergeTolerance, "input units", "distance under which points were merged"),
     integer("TriangulatedPolygons", d.TriangulatedPolygons, "count", "input polygons with more than 3 points split into triangles"),
@@ -50,12 +177,60 @@ std::vector<ResultField> inputResults(const CageResult& r)
     integer("InputComponents", d.Components, "count", "connected parts of the input"),
     integer("InputClosed", d.usable() ? 1 : 0, "", "1: a closed, consistently oriented 2-manifold"),
     integer("InputGenus", d.usable() ? d.Genus : -1, "", "genus of the input (-1: undefined, the input is not closed)"),
-    text("SignMode", signModeName(r.SignUsed), "the inside rule used: flood, winding or unsigned"),
+    text("SignMode", r.SignReason.empty() ? std::string() : std::string(signModeName(r.SignUsed)),
+      "the inside rule used: flood, winding or unsigned (empty when not decided)"),
     text("SignReason", r.SignReason, "why that rule"),
     real("WindingTime", r.WindingSeconds, "s", "winding-number sign (part of DistanceFieldTime)"),
     real("IsoValueUsed", r.IsoValueUsed, "relative", "isovalue of the envelope the cage comes from (unit-sphere units)"),
     integer("EnvelopeWidenings", r.EnvelopeWidenings, "count", "envelopes rebuilt with twice the isovalue to reach the target (inputs without a defined topology only)"),
     text("WideningLog", r.WideningLog, "each envelope tried when widening: isovalue, parts, genus, vertices reached, time"),
+  });
+  return t;
+}
+
+ResultTable optimizeResults(const OptimizeResult& o, double measuredClearanceRelative)
+{
+  ResultTable t = optimizationStatistics(o);
+  append(t, {
+    real("MeasuredClearance", o.MinimumClearance, "input units", "minimum distance between the optimized cage and the input (exact)"),
+    real("MeasuredClearanceRelative", measuredClearanceRelative, "relative", "the same, for the input scaled into the unit sphere"),
+    real("ClearanceUsed", o.ClearanceUsed, "relative", "the clearance enforced"),
+  });
+  return t;
+}
+
+ResultTable activePointResults(const ActivePointAnalysis& a)
+{
+  return {
+    integer("NumberOfActivePoints", static_cast<long long>(a.NumberOfActivePoints), "count", "input points found active (nearly touching another part)"),
+    integer("NumberOfActiveSamples", static_cast<long long>(a.NumberOfActiveSamples), "count", "samples of the active set A on the surface"),
+    integer("NumberOfSamples", static_cast<long long>(a.NumberOfSamples), "count", "samples of the surface"),
+    real("ActivePointTime", a.Seconds, "s", "the whole analysis"),
+  };
+}
+
+ResultTable qualityResults(const CageQualityResult& q)
+{
+  const double diagonal = q.Diagonal > 0 ? q.Diagonal : 1.0;
+  return {
+    flag("Encloses", q.Encloses, "the cage strictly encloses the input"),
+    real("MinimumClearance", q.MinimumClearance, "input units", "exact minimum distance between the surfaces (0 if they touch)"),
+    real("MinimumClearanceRelative", q.MinimumClearance / diagonal, "diagonal", "the same, as a fraction of the input's bounding-box diagonal"),
+    real("HausdorffCageToInput", q.HausdorffCageToInput, "input units", "largest distance from the cage surface to the input (value reached)"),
+    real("HausdorffCageToInputRelative", q.HausdorffCageToInput / diagonal, "diagonal", "the same, as a fraction of the diagonal"),
+    real("HausdorffCageToInputBound", q.HausdorffCageToInputBound, "input units", "certified upper bound of HausdorffCageToInput"),
+    real("HausdorffInputToCage", q.HausdorffInputToCage, "input units", "largest distance from the input surface to the cage (value reached)"),
+    real("HausdorffInputToCageRelative", q.HausdorffInputToCage / diagonal, "diagonal", "the same, as a fraction of the diagonal"),
+    real("HausdorffInputToCageBound", q.HausdorffInputToCageBound, "input units", "certified upper bound of HausdorffInputToCage"),
+    real("MeanDistanceCageToInput", q.MeanDistanceCageToInput, "input units", "area-weighted mean distance from the cage surface to the input"),
+    real("MeanDistanceCageToInputRelative", q.MeanDistanceCageToInput / diagonal, "diagonal", "the same, as a fraction of the diagonal"),
+    integer("SelfIntersections", q.SelfIntersections, "count", "intersecting pairs of non-adjacent cage triangles"),
+    integer("InputIntersections", q.InputIntersections, "count", "intersecting or touching cage/input triangle pairs"),
+    integer("InputVerticesOutside", q.InputVerticesOutside, "count", "input vertices not strictly inside the cage"),
+    integer("CageGenus", q.CageGenus, "", "genus of the cage (-1: not a closed 2-manifold)"),
+    integer("InputGenus", q.InputGenus, "", "genus of the input (-1: not a closed 2-manifold)"),
+    real("QualityTime", q.Seconds, "s", "the evaluation"),
+    text("QualityMessage", q.Message, "why the cage does not enclose, or what could not be evaluated"),
   };
 }
 

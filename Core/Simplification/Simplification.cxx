@@ -291,7 +291,7 @@ public:
     SimplifyResult r;
     const auto t0 = std::chrono::steady_clock::now();
     const int start = AliveVertices;
-    const int target = std::max(4, Opt.TargetVertices);
+    const int target = std::max(4, Opt.TargetNumberOfVertices);
     {
       // the edge of an equilateral triangle of the target's mean area (about 2 target triangles)
       double area = 0;
@@ -329,8 +329,8 @@ public:
     r = Stats;
     r.Cancelled = cancelled || progressCancelled(Prog);
     r.VerticesReached = AliveVertices;
-    r.ReachedTarget = AliveVertices <= target;
-    if (!r.ReachedTarget)
+    r.TargetReached = AliveVertices <= target;
+    if (!r.TargetReached)
       r.StopReason = r.Cancelled ? "cancelled"
                                  : "no remaining collapse keeps the clearance, self-intersection, "
                                    "topology, shape and placement-distance constraints";

@@ -17,7 +17,7 @@ class TriangleTree;
 struct SimplifyOptions
 {
   /// Stop at exactly this many vertices (>= 4 per component).
-  int TargetVertices = 500;
+  int TargetNumberOfVertices = 500;
   /// Every cage triangle keeps at least this distance from every input triangle.
   double Clearance = 0.0025;
   /// Every new cage triangle keeps at least this distance from every cage triangle that shares
@@ -51,7 +51,7 @@ struct SimplifyResult
 {
   TriangleMesh Cage;          ///< unit-sphere units
   int VerticesReached = 0;
-  bool ReachedTarget = false;
+  bool TargetReached = false;
   bool Cancelled = false;
   std::string StopReason;     ///< why it stopped before the target (empty when reached)
   long long Collapses = 0;
@@ -64,7 +64,7 @@ struct SimplifyResult
 };
 
 /// Simplifies `envelope` (closed, outward, unit units, at least `Clearance` from the input) down
-/// to options.TargetVertices vertices. `inputTree` indexes the normalized input. Candidate
+/// to options.TargetNumberOfVertices vertices. `inputTree` indexes the normalized input. Candidate
 /// collapses are evaluated in batches of well-separated edges on all threads and applied in queue
 /// order; an evaluation whose neighbourhood an earlier collapse changed is repeated later.
 /// Deterministic: the batches do not depend on the thread count, nor does the cage.

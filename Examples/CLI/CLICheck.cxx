@@ -5,6 +5,8 @@
 #include "CLIMessages.h"
 #include "CLIReport.h"
 
+#include "Quality/CageQuality.h"
+
 #include <vtkCageQualityFilter.h>
 
 #include <vtkNew.h>
@@ -29,25 +31,27 @@ struct CheckReport
   std::string InputFile, CageFile;
   long long InputPoints = 0, InputTriangles = 0, CagePoints = 0, CageTriangles = 0;
   double ReadTime = 0.0;
-  bool Judged = false;
-  bool Encloses = false;
-  double MinimumClearance = 0, MinimumClearanceRelative = 0;
-  double HausdorffCageToInput = 0, HausdorffCageToInputRelative = 0, HausdorffCageToInputBound = 0;
-  double HausdorffInputToCage = 0, HausdorffInputToCageRelative = 0, HausdorffInputToCageBound = 0;
-  double MeanDistanceCageToInput = 0, MeanDistanceCageToInputRelative = 0;
-  long long SelfIntersections = 0, InputIntersections = 0, InputVerticesOutside = 0;
-  int CageGenus = -1, InputGenus = -1;
-  double QualityTime = 0.0;
-  std::string QualityMessage;
+  /// The judge's results (Core's qualityResults table, read back from the filter by name).
+  sdfcage::ResultTable Results = sdfcage::qualityResults(sdfcage::CageQualityResult());
   std::string Status = "NotRun";
   std::string ErrorMessage;
   int ExitCode = 0;
+
+  double number(const char* name) const
+  {
+    const sdfcage::ResultField* f = sdfcage::findResult(Results, name);
+    return f ? f->number() : 0.0;
+  }
+  std::string text(const char* name) const
+  {
+    const sdfcage::ResultField* f = sdfcage::findResult(Results, name);
+    return f ? f->Text : std::string();
+  }
 };
 
 std::string toJson(const CheckReport& r)
 {
   std::ostringstream o;
-  auto b = [](bool v) { return v ? "true" : "false"; };
   o << "{\n"
     << "  \"Mode\": \"check\",\n"
     << "  \"InputFile\": " << jsonString(r.InputFile) << ",\n"
@@ -55,26 +59,11 @@ std::string toJson(const CheckReport& r)
     << "  \"InputPoints\": " << r.InputPoints << ",\n"
     << "  \"InputTriangles\": " << r.InputTriangles << ",\n"
     << "  \"CagePoints\": " << r.CagePoints << ",\n"
-    << "  \"CageTriangles\": " << r.CageTriangles << ",\n"
-    << "  \"Encloses\": " << b(r.Encloses) << ",\n"
-    << "  \"MinimumClearance\": " << jsonNumber(r.MinimumClearance) << ",\n"
-    << "  \"MinimumClearanceRelative\": " << jsonNumber(r.MinimumClearanceRelative) << ",\n"
-    << "  \"HausdorffCageToInput\": " << jsonNumber(r.HausdorffCageToInput) << ",\n"
-    << "  \"HausdorffCageToInputRelative\": " << jsonNumber(r.HausdorffCageToInputRelative) << ",\n"
-    << "  \"HausdorffCageToInputBound\": " << jsonNumber(r.HausdorffCageToInputBound) << ",\n"
-    << "  \"HausdorffInputToCage\": " << jsonNumber(r.HausdorffInputToCage) << ",\n"
-    << "  \"HausdorffInputToCageRelative\": " << jsonNumber(r.HausdorffInputToCageRelative) << ",\n"
-    << "  \"HausdorffInputToCageBound\": " << jsonNumber(r.HausdorffInputToCageBound) << ",\n"
-    << "  \"MeanDistanceCageToInput\": " << jsonNumber(r.MeanDistanceCageToInput) << ",\n"
-    << "  \"MeanDistanceCageToInputRelative\": " << jsonNumber(r.MeanDistanceCageToInputRelative) << ",\n"
-    << "  \"SelfIntersections\": " << r.SelfIntersections << ",\n"
-    << "  \"InputIntersections\": " << r.InputIntersections << ",\n"
-    << "  \"InputVerticesOutside\": " << r.InputVerticesOutside << ",\n"
-    << "  \"CageGenus\": " << r.CageGenus << ",\n"
-    << "  \"InputGenus\": " << r.InputGenus << ",\n"
-    << "  \"QualityMessage\": " << jsonString(r.QualityMessage) << ",\n"
+    << "  \"CageTriangles\": " << r.CageTriangles;
+  bool first = false;
+  writeJsonResults(o, r.Results, first);
+  o << ",\n"
     << "  \"ReadTime\": " << jsonNumber(r.ReadTime) << ",\n"
-    << "  \"QualityTime\": " << jsonNumber(r.QualityTime) << ",\n"
     << "  \"Status\": " << jsonString(r.Status) << ",\n"
     << "  \"ErrorMessage\": " << jsonString(r.ErrorMessage) << ",\n"
     << "  \"ExitCode\": " << r.ExitCode << "\n"
@@ -159,47 +148,39 @@ int runCheck(const std::string& inputPath, const std::string& cagePath, const st
     return finishCheck(r, report, 3);
   }
   messages->clear();
-  r.Judged = true;
   r.Status = "Ok";
-  r.Encloses = quality->GetEncloses();
-  r.MinimumClearance = quality->GetMinimumClearance();
-  r.MinimumClearanceRelative = quality->GetMinimumClearanceRelative();
-  r.HausdorffCageToInput = quality->GetHausdorffCageToInput();
-  r.HausdorffCageToInputRelative = quality->GetHausdorffCageToInputRelative();
-  r.HausdorffCageToInputBound = quality->GetHausdorffCageToInputBound();
-  r.HausdorffInputToCage = quality->GetHausdorffInputToCage();
-  r.HausdorffInputToCageRelative = quality->GetHausdorffInputToCageRelative();
-  r.HausdorffInputToCageBound = quality->GetHausdorffInputToCageBound();
-  r.MeanDistanceCageToInput = quality->GetMeanDistanceCageToInput();
-  r.MeanDistanceCageToInputRelative = quality->GetMeanDistanceCageToInputRelative();
-  r.SelfIntersections = quality->GetSelfIntersections();
-  r.InputIntersections = quality->GetInputIntersections();
-  r.InputVerticesOutside = quality->GetInputVerticesOutside();
-  r.CageGenus = quality->GetCageGenus();
-  r.InputGenus = quality->GetInputGenus();
-  r.QualityTime = quality->GetQualityTime();
-  r.QualityMessage = quality->GetQualityMessage();
+  for (sdfcage::ResultField& f : r.Results)
+  {
+    if (f.Type == sdfcage::ResultField::Kind::Text)
+      f.Text = quality->GetResultText(f.Name.c_str());
+    else
+      f.setNumber(quality->GetResultNumber(f.Name.c_str()));
+  }
 
+  const bool encloses = r.number("Encloses") != 0;
   if (!quiet)
   {
-    auto genus = [](int v) { return v < 0 ? std::string("n/a (not a closed 2-manifold)") : std::to_string(v); };
+    auto genus = [](double v) { return v < 0 ? std::string("n/a (not a closed 2-manifold)") : std::to_string(static_cast<int>(v)); };
+    auto count = [&](const char* name) { return static_cast<long long>(r.number(name)); };
     std::cout << "input       : " << inputPath << ", " << r.InputPoints << " points, " << r.InputTriangles
-              << " triangles, genus " << genus(r.InputGenus) << "\n"
+              << " triangles, genus " << genus(r.number("InputGenus")) << "\n"
               << "cage        : " << cagePath << ", " << r.CagePoints << " points, " << r.CageTriangles
-              << " triangles, genus " << genus(r.CageGenus) << "\n"
-              << "clearance   : " << g(r.MinimumClearance) << " (input units) = " << g(r.MinimumClearanceRelative)
-              << " of the input's diagonal\n"
-              << "Hausdorff   : cage->input " << g(r.HausdorffCageToInput) << " (" << g(r.HausdorffCageToInputRelative)
-              << " rel.), input->cage " << g(r.HausdorffInputToCage) << " (" << g(r.HausdorffInputToCageRelative)
+              << " triangles, genus " << genus(r.number("CageGenus")) << "\n"
+              << "clearance   : " << g(r.number("MinimumClearance")) << " (input units) = "
+              << g(r.number("MinimumClearanceRelative")) << " of the input's diagonal\n"
+              << "Hausdorff   : cage->input " << g(r.number("HausdorffCageToInput")) << " ("
+              << g(r.number("HausdorffCageToInputRelative")) << " rel.), input->cage "
+              << g(r.number("HausdorffInputToCage")) << " (" << g(r.number("HausdorffInputToCageRelative"))
               << " rel.)\n"
-              << "mean dist.  : cage->input " << g(r.MeanDistanceCageToInput) << " ("
-              << g(r.MeanDistanceCageToInputRelative) << " rel.)\n"
-              << "counts      : " << r.SelfIntersections << " self-intersecting pairs, " << r.InputIntersections
-              << " cage/input intersecting pairs, " << r.InputVerticesOutside << " input vertices outside\n"
-              << "time        : " << g(r.QualityTime) << " s\n"
-              << "encloses    : " << (r.Encloses ? std::string("yes") : "NO: " + r.QualityMessage) << "\n";
+              << "mean dist.  : cage->input " << g(r.number("MeanDistanceCageToInput")) << " ("
+              << g(r.number("MeanDistanceCageToInputRelative")) << " rel.)\n"
+              << "counts      : " << count("SelfIntersections") << " self-intersecting pairs, "
+              << count("InputIntersections") << " cage/input intersecting pairs, " << count("InputVerticesOutside")
+              << " input vertices outside\n"
+              << "time        : " << g(r.number("QualityTime")) << " s\n"
+              << "encloses    : " << (encloses ? std::string("yes") : "NO: " + r.text("QualityMessage")) << "\n";
   }
-  return finishCheck(r, report, r.Encloses ? 0 : 1);
+  return finishCheck(r, report, encloses ? 0 : 1);
 }
 
 } // namespace sdfcage_cli

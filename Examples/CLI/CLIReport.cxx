@@ -1,6 +1,7 @@
 // SDFCage — CLI: see CLIReport.h.
 #include "CLIReport.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -78,6 +79,42 @@ std::string number(double v)
 
 } // namespace
 
+double RunReport::number(const char* name) const
+{
+  const sdfcage::ResultField* f = sdfcage::findResult(Results, name);
+  return f ? f->number() : 0.0;
+}
+
+std::string RunReport::text(const char* name) const
+{
+  const sdfcage::ResultField* f = sdfcage::findResult(Results, name);
+  return f && f->Type == sdfcage::ResultField::Kind::Text ? f->Text : std::string();
+}
+
+void writeJsonResults(std::ostream& os, const sdfcage::ResultTable& results, bool& first)
+{
+  for (const sdfcage::ResultField& f : results)
+  {
+    os << (first ? "\n" : ",\n") << "  " << jsonString(f.Name) << ": ";
+    first = false;
+    switch (f.Type)
+    {
+      case sdfcage::ResultField::Kind::Flag:
+        os << (f.Integer ? "true" : "false");
+        break;
+      case sdfcage::ResultField::Kind::Integer:
+        os << f.Integer;
+        break;
+      case sdfcage::ResultField::Kind::Real:
+        os << jsonNumber(f.Real);
+        break;
+      case sdfcage::ResultField::Kind::Text:
+        os << jsonString(f.Text);
+        break;
+    }
+  }
+}
+
 std::string toJson(const RunReport& r)
 {
   std::ostringstream os;
@@ -88,12 +125,14 @@ std::string toJson(const RunReport& r)
     return os;
   };
   os << "{";
+  // the run
   key("InputFile") << jsonString(r.InputFile);
   key("OutputFile") << jsonString(r.OutputFile);
   key("ScreenshotFile") << jsonString(r.ScreenshotFile);
   key("Status") << jsonString(r.Status);
   key("ErrorMessage") << jsonString(r.ErrorMessage);
   key("ExitCode") << r.ExitCode;
+  // what was asked
   key("IsoValue") << jsonNumber(r.IsoValue);
   key("VoxelSize") << jsonNumber(r.VoxelSize);
   key("MinimumClearance") << jsonNumber(r.MinimumClearance);
@@ -110,6 +149,8 @@ std::string toJson(const RunReport& r)
   key("GeodesicThreshold") << jsonNumber(r.GeodesicThreshold);
   key("AmplificationAlpha") << jsonNumber(r.AmplificationAlpha);
   key("AmplificationBeta") << jsonNumber(r.AmplificationBeta);
+  key("RequestedSignMode") << jsonString(r.Sign);
+  // the meshes, reading and writing
   key("InputPoints") << r.InputPoints;
   key("InputCells") << r.InputCells;
   key("InputTriangles") << r.InputTriangles;
@@ -118,41 +159,9 @@ std::string toJson(const RunReport& r)
   key("CagePoints") << r.CagePoints;
   key("CageTriangles") << r.CageTriangles;
   key("ReadTime") << jsonNumber(r.ReadTime);
-  key("ValidationTime") << jsonNumber(r.ValidationTime);
-  key("DistanceFieldTime") << jsonNumber(r.DistanceFieldTime);
-  key("IsosurfaceTime") << jsonNumber(r.IsosurfaceTime);
-  key("VerificationTime") << jsonNumber(r.VerificationTime);
-  key("SimplificationTime") << jsonNumber(r.SimplificationTime);
-  key("CageVerificationTime") << jsonNumber(r.CageVerificationTime);
-  key("OptimizationTime") << jsonNumber(r.OptimizationTime);
-  key("EnergyBefore") << jsonNumber(r.EnergyBefore);
-  key("EnergyAfter") << jsonNumber(r.EnergyAfter);
-  key("TotalTime") << jsonNumber(r.TotalTime);
   key("WriteTime") << jsonNumber(r.WriteTime);
-  key("MeasuredClearance") << jsonNumber(r.MeasuredClearance);
-  key("MeasuredClearanceRelative") << jsonNumber(r.MeasuredClearanceRelative);
-  key("EnclosureVerified") << (r.EnclosureVerified ? "true" : "false");
-  key("RemovedPockets") << r.RemovedPockets;
-  key("EnvelopeGenus") << r.EnvelopeGenus;
-  key("EnvelopeComponents") << r.EnvelopeComponents;
-  key("VerticesReached") << r.VerticesReached;
-  key("TargetReached") << (r.TargetReached ? "true" : "false");
-  key("StopReason") << jsonString(r.StopReason);
-  key("VoxelSizeUsed") << jsonNumber(r.VoxelSizeUsed);
-  key("InputWasFlipped") << (r.InputWasFlipped ? "true" : "false");
-  key("NumberOfActivePoints") << r.NumberOfActivePoints;
-  key("ActivePointTime") << jsonNumber(r.ActivePointTime);
-  key("TopologyWarning") << jsonString(r.TopologyWarning);
-  key("RequestedSignMode") << jsonString(r.Sign);
-  for (const sdfcage::ResultField& f : r.InputResults)
-  {
-    if (f.Type == sdfcage::ResultField::Kind::Text)
-      key(f.Name.c_str()) << jsonString(f.Text);
-    else if (f.Type == sdfcage::ResultField::Kind::Real)
-      key(f.Name.c_str()) << jsonNumber(f.Real);
-    else
-      key(f.Name.c_str()) << f.Integer;
-  }
+  // every result of the filter
+  writeJsonResults(os, r.Results, first);
   os << "\n}\n";
   return os.str();
 }
@@ -183,7 +192,7 @@ void printSummary(std::ostream& os, const RunReport& r)
   {
     os << " (from " << r.InputCells << " polygons)";
   }
-  if (r.InputWasFlipped)
+  if (r.flag("InputWasFlipped"))
   {
     os << ", inward-oriented (flipped)";
   }
@@ -192,51 +201,41 @@ void printSummary(std::ostream& os, const RunReport& r)
   {
     return;
   }
-  auto field = [&](const char* name) -> const sdfcage::ResultField* {
-    for (const sdfcage::ResultField& f : r.InputResults)
-      if (f.Name == name)
-        return &f;
-    return nullptr;
-  };
-  auto count = [&](const char* name) { const auto* f = field(name); return f ? f->Integer : 0LL; };
-  auto text = [&](const char* name) { const auto* f = field(name); return f ? f->Text : std::string(); };
-  if (!r.InputResults.empty())
-  {
-    os << "repairs     : " << count("MergedPoints") << " points merged, " << count("TriangulatedPolygons")
-       << " polygons triangulated, " << count("DroppedDegenerateTriangles") << " degenerate and "
-       << count("DroppedDuplicateTriangles") << " duplicated triangles dropped\n";
-    os << "inside rule : " << text("SignMode") << " (" << text("SignReason") << "); " << count("InputComponents")
-       << " component(s), " << count("InputBoundaryEdges") << " boundary edges, " << count("InputNonManifoldEdges")
-       << " non-manifold edges, " << count("InputNonManifoldVertices") << " non-manifold vertices";
-    if (count("InputClosed"))
-      os << ", genus " << count("InputGenus");
-    os << "\n";
-  }
-  if (r.UseActivePoints && text("SignMode") != "flood" && !text("SignMode").empty())
+  os << "repairs     : " << r.integer("MergedPoints") << " points merged, " << r.integer("TriangulatedPolygons")
+     << " polygons triangulated, " << r.integer("DroppedDegenerateTriangles") << " degenerate and "
+     << r.integer("DroppedDuplicateTriangles") << " duplicated triangles dropped\n";
+  os << "inside rule : " << r.text("SignMode") << " (" << r.text("SignReason") << "); " << r.integer("InputComponents")
+     << " component(s), " << r.integer("InputBoundaryEdges") << " boundary edges, "
+     << r.integer("InputNonManifoldEdges") << " non-manifold edges, " << r.integer("InputNonManifoldVertices")
+     << " non-manifold vertices";
+  if (r.integer("InputClosed"))
+    os << ", genus " << r.integer("InputGenus");
+  os << "\n";
+  const std::string sign = r.text("SignMode");
+  if (r.UseActivePoints && sign != "flood" && !sign.empty())
   {
     os << "active pts  : skipped (they need a closed input and the flood-fill rule)\n";
   }
   else if (r.UseActivePoints)
   {
-    os << "active pts  : " << r.NumberOfActivePoints << " input points (r " << number(r.ActiveRadius)
-       << ", l " << number(r.GeodesicThreshold) << ", alpha " << number(r.AmplificationAlpha)
-       << ", beta " << number(r.AmplificationBeta) << "), " << seconds(r.ActivePointTime) << "\n";
+    os << "active pts  : " << r.integer("NumberOfActivePoints") << " input points (r " << number(r.ActiveRadius)
+       << ", l " << number(r.GeodesicThreshold) << ", alpha " << number(r.AmplificationAlpha) << ", beta "
+       << number(r.AmplificationBeta) << "), " << seconds(r.number("ActivePointTime")) << "\n";
   }
   else
   {
     os << "active pts  : off (plain offset)\n";
   }
-  os << "envelope    : " << r.EnvelopePoints << " points, " << r.EnvelopeTriangles
-     << " triangles, " << r.EnvelopeComponents << " component(s), genus " << r.EnvelopeGenus
-     << ", " << r.RemovedPockets << " trapped pocket(s) removed\n";
+  os << "envelope    : " << r.EnvelopePoints << " points, " << r.EnvelopeTriangles << " triangles, "
+     << r.integer("EnvelopeComponents") << " component(s), genus " << r.integer("EnvelopeGenus") << ", "
+     << r.integer("RemovedPockets") << " trapped pocket(s) removed\n";
   os << "cage        : " << r.CagePoints << " points, " << r.CageTriangles << " triangles";
   if (r.TargetNumberOfVertices > 0)
   {
-    os << (r.TargetReached ? " (target " : " (target NOT reached: ") << r.TargetNumberOfVertices
-       << (r.TargetReached ? std::string(" reached")
-            : r.StopReason.empty() ? std::string()
-                                   : std::string("; ") + r.StopReason)
-       << ")";
+    const bool reached = r.flag("TargetReached");
+    const std::string stop = r.text("StopReason");
+    os << (reached ? " (target " : " (target NOT reached: ") << r.TargetNumberOfVertices
+       << (reached ? std::string(" reached") : stop.empty() ? std::string() : std::string("; ") + stop) << ")";
   }
   else
   {
@@ -247,24 +246,44 @@ void printSummary(std::ostream& os, const RunReport& r)
     os << " -> " << r.OutputFile;
   }
   os << "\n";
-  os << "voxel size  : " << number(r.VoxelSizeUsed) << " (relative: the input scaled into the "
-     << "unit sphere), isovalue " << number(r.IsoValue) << ", adaptivity "
-     << number(r.Adaptivity) << "\n";
-  os << "timings     : validation " << seconds(r.ValidationTime) << ", distance field "
-     << seconds(r.DistanceFieldTime) << ", active points " << seconds(r.ActivePointTime) << ", isosurface " << seconds(r.IsosurfaceTime)
-     << ", verification " << seconds(r.VerificationTime) << ",\n              simplification "
-     << seconds(r.SimplificationTime) << ", cage verification "
-     << seconds(r.CageVerificationTime) << ", total " << seconds(r.TotalTime) << "\n";
+  os << "voxel size  : " << number(r.number("VoxelSizeUsed")) << " (relative: the input scaled into the "
+     << "unit sphere), isovalue " << number(r.IsoValue) << ", adaptivity " << number(r.Adaptivity) << "\n";
+  os << "timings     : validation " << seconds(r.number("ValidationTime")) << ", distance field "
+     << seconds(r.number("DistanceFieldTime")) << ", active points " << seconds(r.number("ActivePointTime"))
+     << ", isosurface " << seconds(r.number("IsosurfaceTime")) << ", verification "
+     << seconds(r.number("VerificationTime")) << ",\n              simplification "
+     << seconds(r.number("SimplificationTime")) << ", cage verification "
+     << seconds(r.number("CageVerificationTime")) << ", total " << seconds(r.number("TotalTime")) << "\n";
   if (r.Optimize != "none")
   {
-    os << "optimization: " << r.Optimize << " energy " << number(r.EnergyBefore) << " -> "
-       << number(r.EnergyAfter) << ", " << r.NumberOfIterations << " iteration(s), "
-       << seconds(r.OptimizationTime) << "\n";
+    os << "optimization: " << r.Optimize << " energy " << number(r.number("EnergyBefore")) << " -> "
+       << number(r.number("EnergyAfter")) << ", " << r.NumberOfIterations << " iteration(s), "
+       << seconds(r.number("OptimizationTime")) << "\n";
   }
-  os << "clearance   : " << number(r.MeasuredClearance) << " (input units) = "
-     << number(r.MeasuredClearanceRelative) << " relative, required >= "
-     << number(r.MinimumClearanceUsed) << " relative\n";
-  os << "enclosure verified: " << (r.EnclosureVerified ? "yes" : "no") << "\n";
+  os << "clearance   : " << number(r.number("MeasuredClearance")) << " (input units) = "
+     << number(r.number("MeasuredClearanceRelative")) << " relative, required >= " << number(r.MinimumClearanceUsed)
+     << " relative\n";
+  os << "enclosure verified: " << (r.flag("EnclosureVerified") ? "yes" : "no") << "\n";
+}
+
+void printResults(std::ostream& os, const sdfcage::ResultTable& results)
+{
+  std::size_t width = 0;
+  for (const sdfcage::ResultField& f : results)
+  {
+    width = std::max(width, f.Name.size());
+  }
+  os << "results:\n";
+  for (const sdfcage::ResultField& f : results)
+  {
+    std::string value = f.toString();
+    if (!f.Unit.empty() && f.Unit != "count")
+    {
+      value += " " + f.Unit;
+    }
+    os << "  " << f.Name << std::string(width - f.Name.size(), ' ') << " = " << value << "  (" << f.Description
+       << ")\n";
+  }
 }
 
 } // namespace sdfcage_cli

@@ -1,6 +1,7 @@
 // SDFCage — CLI: what one run did, as a text summary and as a JSON report.
 #pragma once
 
+#include "Pipeline/CageGenerator.h"
 #include "Pipeline/Results.h"
 
 #include <ostream>
@@ -14,6 +15,12 @@ namespace sdfcage_cli
 /// the JSON keys are exactly these names.
 struct RunReport
 {
+  /// A result of the table by name: its number (flags 0/1, 0 when absent) or its text.
+  double number(const char* name) const;
+  long long integer(const char* name) const { return static_cast<long long>(number(name)); }
+  bool flag(const char* name) const { return number(name) != 0.0; }
+  std::string text(const char* name) const;
+
   // what was asked
   std::string InputFile;  ///< path, or "builtin" for the built-in shape
   std::string OutputFile; ///< path written, "" when nothing was written
@@ -46,36 +53,11 @@ struct RunReport
   long long CagePoints = 0;
   long long CageTriangles = 0;
 
-  // the filter's results
   double ReadTime = 0.0;
-  double ValidationTime = 0.0;
-  double DistanceFieldTime = 0.0;
-  double IsosurfaceTime = 0.0;
-  double VerificationTime = 0.0;
-  double SimplificationTime = 0.0;
-  double CageVerificationTime = 0.0;
-  double OptimizationTime = 0.0;
-  double EnergyBefore = 0.0; ///< optimization energy of the simplified cage (with --optimize)
-  double EnergyAfter = 0.0;  ///< ... and of the optimized one
-  double TotalTime = 0.0;
   double WriteTime = 0.0;
-  double MeasuredClearance = 0.0;
-  double MeasuredClearanceRelative = 0.0;
-  bool EnclosureVerified = false;
-  int RemovedPockets = 0;
-  int EnvelopeGenus = 0;
-  int EnvelopeComponents = 0;
-  int VerticesReached = 0;
-  bool TargetReached = false;
-  std::string StopReason; ///< why the simplification stopped early ("" when it reached N)
-  double VoxelSizeUsed = 0.0;
-  bool InputWasFlipped = false;
-  long long NumberOfActivePoints = 0; ///< input points found active
-  double ActivePointTime = 0.0;
-  std::string TopologyWarning; ///< set when the envelope's genus/components differ from the input's
-  /// What was done to the input and how its inside was decided (Core's inputResults table,
-  /// read back from the filter by name): JSON keys and summary lines come from it.
-  std::vector<sdfcage::ResultField> InputResults;
+  /// Every result of the cage filter (Core's cageResults table, read back from the filter by
+  /// name): JSON keys and summary values come from it.
+  sdfcage::ResultTable Results = sdfcage::cageResults(sdfcage::CageResult());
   bool FilterRan = false; ///< false when the run stopped before the filter (e.g. unreadable)
 
   // outcome
@@ -86,6 +68,12 @@ struct RunReport
 
 /// The human-readable summary (several lines).
 void printSummary(std::ostream& os, const RunReport& r);
+
+/// Every result of the table, one per line: name, value, unit and description (--verbose).
+void printResults(std::ostream& os, const sdfcage::ResultTable& results);
+
+/// A table's results as JSON members (`"Name": value`, flags as true/false), for the reports.
+void writeJsonResults(std::ostream& os, const sdfcage::ResultTable& results, bool& first);
 
 /// Writes the JSON report. Returns false with a reason.
 bool writeJsonReport(const RunReport& r, const std::string& path, std::string& error);

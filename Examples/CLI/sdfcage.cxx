@@ -3,8 +3,8 @@
 //   sdfcage [INPUT] [-o OUT] [-n N] [--iso C] [--voxel H] [--clearance D] [--adaptivity A]
 //           [--refinements N] [--sign auto|flood|winding|unsigned] [--no-active-points] [--active-radius R] [--geodesic-threshold L]
 //           [--alpha A] [--beta B] [--optimize none|mips|spacing] [--spacing H] [--iterations K]
-//           [--report FILE.json] [--screenshot FILE.png] [--threads N] [--quiet] [--help]
-//           [--version]
+//           [--report FILE.json] [--screenshot FILE.png] [--threads N] [--quiet] [--verbose]
+//           [--help] [--version]
 //   sdfcage --check INPUT CAGE [--report FILE.json] [--quiet]
 //
 // Exit codes: 0 cage written and enclosure verified; 1 enclosure could not be verified;
@@ -111,6 +111,7 @@ void printUsage(std::ostream& os)
         "                          on a headless machine run under `xvfb-run -a`)\n"
         "      --threads N         worker threads, default 0 = all cores\n"
         "  -q, --quiet             no progress bar, no summary (errors are still printed)\n"
+        "  -v, --verbose           after the summary, every result with its unit and meaning\n"
         "  -h, --help              this help\n"
         "      --version           program and library versions\n"
         "\n"
@@ -147,6 +148,7 @@ struct Options
   int Iterations = -1;           ///< -1 = the filter's default
   int Threads = 0;
   bool Quiet = false;
+  bool Verbose = false; ///< every result after the summary
   bool Help = false;
   bool Version = false;
   bool Check = false;      ///< --check INPUT CAGE
@@ -184,223 +186,244 @@ int parseInt(const std::string& option, const std::string& text, int lo, int hi)
   return static_cast<int>(v);
 }
 
-Options parseOptions(int argc, char* argv[], vtkSDFCageFilter* limits)
+/// Walks the command line one argument at a time: an option (`-n 5`, `--iso 0.02`,
+/// `--iso=0.02`) with its value, or a positional (a file; everything after `--`).
+class ArgumentCursor
 {
-  Options o;
-  bool positionalOnly = false;
-  std::vector<std::string> positionals;
-  std::vector<std::string> buildOptions; // options that only make sense when building a cage
-  for (int i = 1; i < argc; ++i)
+public:
+  ArgumentCursor(int argc, char* argv[])
+    : Argc(argc)
+    , Argv(argv)
   {
-    std::string arg = argv[i];
-    if (positionalOnly || arg.empty() || arg[0] != '-' || arg == "-")
+  }
+
+  /// Moves to the next argument; false at the end.
+  bool next()
+  {
+    if (++this->Index >= this->Argc)
     {
-      if (arg.empty())
+      return false;
+    }
+    this->Name = this->Argv[this->Index];
+    this->Value.clear();
+    this->HasInlineValue = false;
+    this->Positional = this->PositionalOnly || this->Name.empty() || this->Name[0] != '-' || this->Name == "-";
+    if (this->Positional)
+    {
+      if (this->Name.empty())
       {
         throw UsageError{ "empty input file name" };
       }
-      positionals.push_back(arg);
-      continue;
+      return true;
     }
-    if (arg == "--")
+    if (this->Name == "--")
     {
-      positionalOnly = true;
-      continue;
+      this->PositionalOnly = true;
+      return this->next();
     }
-    // --name=value or --name value
-    std::string value;
-    bool hasInlineValue = false;
-    if (arg.compare(0, 2, "--") == 0)
+    if (this->Name.compare(0, 2, "--") == 0) // --name=value
     {
-      const std::size_t eq = arg.find('=');
+      const std::size_t eq = this->Name.find('=');
       if (eq != std::string::npos)
       {
-        value = arg.substr(eq + 1);
-        arg = arg.substr(0, eq);
-        hasInlineValue = true;
+        this->Value = this->Name.substr(eq + 1);
+        this->Name = this->Name.substr(0, eq);
+        this->HasInlineValue = true;
       }
     }
-    auto takeValue = [&]() -> std::string {
-      if (hasInlineValue)
-      {
-        return value;
-      }
-      if (i + 1 >= argc)
-      {
-        throw UsageError{ "option " + arg + " needs a value" };
-      }
-      return argv[++i];
-    };
-    auto noValue = [&]() {
-      if (hasInlineValue)
-      {
-        throw UsageError{ "option " + arg + " takes no value" };
-      }
-    };
+    return true;
+  }
 
-    if (arg != "--report" && arg != "-q" && arg != "--quiet" && arg != "--check" && arg != "-h" &&
-      arg != "--help" && arg != "--version")
-    {
-      buildOptions.push_back(arg);
-    }
-    if (arg == "--check")
-    {
-      noValue();
-      o.Check = true;
-    }
-    else if (arg == "-h" || arg == "--help")
-    {
-      noValue();
-      o.Help = true;
-    }
-    else if (arg == "--version")
-    {
-      noValue();
-      o.Version = true;
-    }
-    else if (arg == "-q" || arg == "--quiet")
-    {
-      noValue();
-      o.Quiet = true;
-    }
-    else if (arg == "-o" || arg == "--output")
-    {
-      o.Output = takeValue();
-      if (o.Output.empty())
-      {
-        throw UsageError{ "option " + arg + " needs a file name" };
-      }
-    }
-    else if (arg == "--report")
-    {
-      o.Report = takeValue();
-      if (o.Report.empty())
-      {
-        throw UsageError{ "option --report needs a file name" };
-      }
-    }
-    else if (arg == "--screenshot")
-    {
-      o.Screenshot = takeValue();
-      if (lowerExtension(o.Screenshot) != ".png")
-      {
-        throw UsageError{ "--screenshot writes PNG: the file name must end in .png, got '" +
-          o.Screenshot + "'" };
-      }
-    }
-    else if (arg == "--iso")
-    {
-      o.IsoValue = parseDouble(
-        arg, takeValue(), limits->GetIsoValueMinValue(), limits->GetIsoValueMaxValue());
-    }
-    else if (arg == "--voxel")
-    {
-      o.VoxelSize = parseDouble(
-        arg, takeValue(), limits->GetVoxelSizeMinValue(), limits->GetVoxelSizeMaxValue());
-    }
-    else if (arg == "--clearance")
-    {
-      o.Clearance = parseDouble(arg, takeValue(), limits->GetMinimumClearanceMinValue(),
-        limits->GetMinimumClearanceMaxValue());
-    }
-    else if (arg == "-n" || arg == "--vertices")
-    {
-      o.Vertices = parseInt(arg, takeValue(), limits->GetTargetNumberOfVerticesMinValue(),
-        limits->GetTargetNumberOfVerticesMaxValue());
-    }
-    else if (arg == "--adaptivity")
-    {
-      o.Adaptivity = parseDouble(arg, takeValue(), limits->GetAdaptivityMinValue(),
-        limits->GetAdaptivityMaxValue());
-    }
-    else if (arg == "--refinements")
-    {
-      o.Refinements = parseInt(arg, takeValue(), limits->GetMaximumRefinementsMinValue(),
-        limits->GetMaximumRefinementsMaxValue());
-    }
-    else if (arg == "--no-active-points")
-    {
-      o.NoActivePoints = true;
-    }
-    else if (arg == "--active-radius")
-    {
-      o.ActiveRadius = parseDouble(arg, takeValue(), limits->GetActiveRadiusMinValue(), limits->GetActiveRadiusMaxValue());
-    }
-    else if (arg == "--geodesic-threshold")
-    {
-      o.GeodesicThreshold = parseDouble(
-        arg, takeValue(), limits->GetGeodesicThresholdMinValue(), limits->GetGeodesicThresholdMaxValue());
-    }
-    else if (arg == "--alpha")
-    {
-      o.Alpha = parseDouble(
-        arg, takeValue(), limits->GetAmplificationAlphaMinValue(), limits->GetAmplificationAlphaMaxValue());
-    }
-    else if (arg == "--beta")
-    {
-      o.Beta = parseDouble(
-        arg, takeValue(), limits->GetAmplificationBetaMinValue(), limits->GetAmplificationBetaMaxValue());
-    }
-    else if (arg == "--sign")
-    {
-      o.Sign = takeValue();
-      if (o.Sign != "auto" && o.Sign != "flood" && o.Sign != "winding" && o.Sign != "unsigned")
-      {
-        throw UsageError{ "--sign expects auto, flood, winding or unsigned, got '" + o.Sign + "'" };
-      }
-    }
-    else if (arg == "--optimize")
-    {
-      o.Optimize = takeValue();
-      if (o.Optimize != "none" && o.Optimize != "mips" && o.Optimize != "spacing")
-      {
-        throw UsageError{ "--optimize expects none, mips or spacing, got '" + o.Optimize + "'" };
-      }
-    }
-    else if (arg == "--spacing")
-    {
-      o.Spacing = parseDouble(
-        arg, takeValue(), limits->GetTargetSpacingMinValue(), limits->GetTargetSpacingMaxValue());
-    }
-    else if (arg == "--iterations")
-    {
-      o.Iterations = parseInt(arg, takeValue(), limits->GetNumberOfIterationsMinValue(),
-        limits->GetNumberOfIterationsMaxValue());
-    }
-    else if (arg == "--threads")
-    {
-      o.Threads = parseInt(arg, takeValue(), limits->GetNumberOfThreadsMinValue(),
-        limits->GetNumberOfThreadsMaxValue());
-    }
-    else
-    {
-      throw UsageError{ "unknown option '" + arg + "'" };
-    }
-  }
-  if (o.Check && !o.Help && !o.Version)
+  bool positional() const { return this->Positional; }
+  /// The option's name (without "=value"), or the positional argument.
+  const std::string& name() const { return this->Name; }
+
+  /// The option's value: after "=", or the next argument.
+  std::string value()
   {
-    if (positionals.size() != 2)
+    if (this->HasInlineValue)
     {
-      throw UsageError{ "--check needs two files, INPUT and CAGE (got " +
-        std::to_string(positionals.size()) + ")" };
+      return this->Value;
     }
-    if (!buildOptions.empty())
+    if (this->Index + 1 >= this->Argc)
     {
-      throw UsageError{ "--check takes only --report and --quiet; '" + buildOptions.front() +
-        "' is an option for building a cage" };
+      throw UsageError{ "option " + this->Name + " needs a value" };
     }
-    o.Input = positionals[0];
-    o.Cage = positionals[1];
-    for (const std::string& file : positionals)
-    {
-      if (!isSupportedExtension(file))
-      {
-        throw UsageError{ "cannot read '" + file + "': unknown extension '" + lowerExtension(file) +
-          "' (supported: " + supportedExtensions() + ")" };
-      }
-    }
-    return o;
+    return this->Argv[++this->Index];
   }
+
+  /// For a switch: "--quiet=1" is an error.
+  void noValue() const
+  {
+    if (this->HasInlineValue)
+    {
+      throw UsageError{ "option " + this->Name + " takes no value" };
+    }
+  }
+
+  double number(double lo, double hi) { return parseDouble(this->Name, this->value(), lo, hi); }
+  int integer(int lo, int hi) { return parseInt(this->Name, this->value(), lo, hi); }
+
+private:
+  int Argc;
+  char** Argv;
+  int Index = 0;
+  std::string Name;
+  std::string Value;
+  bool HasInlineValue = false;
+  bool Positional = false;
+  bool PositionalOnly = false;
+};
+
+/// The options of every mode: --check, --help, --version, --quiet, --report. False if `a` is not
+/// one of them.
+bool parseCommonOption(ArgumentCursor& a, Options& o)
+{
+  const std::string& arg = a.name();
+  if (arg == "--check")
+  {
+    a.noValue();
+    o.Check = true;
+  }
+  else if (arg == "-h" || arg == "--help")
+  {
+    a.noValue();
+    o.Help = true;
+  }
+  else if (arg == "--version")
+  {
+    a.noValue();
+    o.Version = true;
+  }
+  else if (arg == "-q" || arg == "--quiet")
+  {
+    a.noValue();
+    o.Quiet = true;
+  }
+  else if (arg == "--report")
+  {
+    o.Report = a.value();
+    if (o.Report.empty())
+    {
+      throw UsageError{ "option --report needs a file name" };
+    }
+  }
+  else
+  {
+    return false;
+  }
+  return true;
+}
+
+/// The options of building a cage (the ranges are the filter's). False if `a` is not one of them.
+bool parseBuildOption(ArgumentCursor& a, Options& o, vtkSDFCageFilter* limits)
+{
+  const std::string& arg = a.name();
+  if (arg == "-o" || arg == "--output")
+  {
+    o.Output = a.value();
+    if (o.Output.empty())
+    {
+      throw UsageError{ "option " + arg + " needs a file name" };
+    }
+  }
+  else if (arg == "--screenshot")
+  {
+    o.Screenshot = a.value();
+    if (lowerExtension(o.Screenshot) != ".png")
+    {
+      throw UsageError{ "--screenshot writes PNG: the file name must end in .png, got '" + o.Screenshot + "'" };
+    }
+  }
+  else if (arg == "--iso")
+    o.IsoValue = a.number(limits->GetIsoValueMinValue(), limits->GetIsoValueMaxValue());
+  else if (arg == "--voxel")
+    o.VoxelSize = a.number(limits->GetVoxelSizeMinValue(), limits->GetVoxelSizeMaxValue());
+  else if (arg == "--clearance")
+    o.Clearance = a.number(limits->GetMinimumClearanceMinValue(), limits->GetMinimumClearanceMaxValue());
+  else if (arg == "-n" || arg == "--vertices")
+    o.Vertices = a.integer(limits->GetTargetNumberOfVerticesMinValue(), limits->GetTargetNumberOfVerticesMaxValue());
+  else if (arg == "--adaptivity")
+    o.Adaptivity = a.number(limits->GetAdaptivityMinValue(), limits->GetAdaptivityMaxValue());
+  else if (arg == "--refinements")
+    o.Refinements = a.integer(limits->GetMaximumRefinementsMinValue(), limits->GetMaximumRefinementsMaxValue());
+  else if (arg == "--no-active-points")
+    o.NoActivePoints = true;
+  else if (arg == "--active-radius")
+    o.ActiveRadius = a.number(limits->GetActiveRadiusMinValue(), limits->GetActiveRadiusMaxValue());
+  else if (arg == "--geodesic-threshold")
+    o.GeodesicThreshold = a.number(limits->GetGeodesicThresholdMinValue(), limits->GetGeodesicThresholdMaxValue());
+  else if (arg == "--alpha")
+    o.Alpha = a.number(limits->GetAmplificationAlphaMinValue(), limits->GetAmplificationAlphaMaxValue());
+  else if (arg == "--beta")
+    o.Beta = a.number(limits->GetAmplificationBetaMinValue(), limits->GetAmplificationBetaMaxValue());
+  else if (arg == "--sign")
+  {
+    o.Sign = a.value();
+    if (o.Sign != "auto" && o.Sign != "flood" && o.Sign != "winding" && o.Sign != "unsigned")
+    {
+      throw UsageError{ "--sign expects auto, flood, winding or unsigned, got '" + o.Sign + "'" };
+    }
+  }
+  else if (arg == "--optimize")
+  {
+    o.Optimize = a.value();
+    if (o.Optimize != "none" && o.Optimize != "mips" && o.Optimize != "spacing")
+    {
+      throw UsageError{ "--optimize expects none, mips or spacing, got '" + o.Optimize + "'" };
+    }
+  }
+  else if (arg == "--spacing")
+    o.Spacing = a.number(limits->GetTargetSpacingMinValue(), limits->GetTargetSpacingMaxValue());
+  else if (arg == "--iterations")
+    o.Iterations = a.integer(limits->GetNumberOfIterationsMinValue(), limits->GetNumberOfIterationsMaxValue());
+  else if (arg == "--threads")
+    o.Threads = a.integer(limits->GetNumberOfThreadsMinValue(), limits->GetNumberOfThreadsMaxValue());
+  else if (arg == "-v" || arg == "--verbose")
+  {
+    a.noValue();
+    o.Verbose = true;
+  }
+  else
+  {
+    return false;
+  }
+  return true;
+}
+
+void checkSupported(const std::string& file, const char* verb)
+{
+  if (!isSupportedExtension(file))
+  {
+    throw UsageError{ std::string("cannot ") + verb + " '" + file + "': unknown extension '" + lowerExtension(file) +
+      "' (supported: " + supportedExtensions() + ")" };
+  }
+}
+
+/// --check INPUT CAGE: two files, and no option of building a cage.
+void finishCheckOptions(Options& o, const std::vector<std::string>& positionals, const std::vector<std::string>& buildOptions)
+{
+  if (positionals.size() != 2)
+  {
+    throw UsageError{ "--check needs two files, INPUT and CAGE (got " + std::to_string(positionals.size()) + ")" };
+  }
+  if (!buildOptions.empty())
+  {
+    throw UsageError{ "--check takes only --report and --quiet; '" + buildOptions.front() +
+      "' is an option for building a cage" };
+  }
+  o.Input = positionals[0];
+  o.Cage = positionals[1];
+  for (const std::string& file : positionals)
+  {
+    checkSupported(file, "read");
+  }
+}
+
+/// Building a cage: at most one input (none: the built-in shape), known formats, the default
+/// output name.
+void finishBuildOptions(Options& o, const std::vector<std::string>& positionals)
+{
   if (positionals.size() > 1)
   {
     throw UsageError{ "more than one input given ('" + positionals[0] + "' and '" + positionals[1] +
@@ -410,21 +433,49 @@ Options parseOptions(int argc, char* argv[], vtkSDFCageFilter* limits)
   {
     o.Input = positionals[0];
   }
-  if (!o.Input.empty() && !isSupportedExtension(o.Input))
+  if (!o.Input.empty())
   {
-    throw UsageError{ "cannot read '" + o.Input + "': unknown extension '" +
-      lowerExtension(o.Input) + "' (supported: " + supportedExtensions() + ")" };
+    checkSupported(o.Input, "read");
   }
-  if (!o.Output.empty() && !isSupportedExtension(o.Output))
+  if (!o.Output.empty())
   {
-    throw UsageError{ "cannot write '" + o.Output + "': unknown extension '" +
-      lowerExtension(o.Output) + "' (supported: " + supportedExtensions() + ")" };
+    checkSupported(o.Output, "write");
   }
   if (o.Output.empty())
   {
-    const std::string stem =
-      o.Input.empty() ? std::string("builtin") : std::filesystem::path(o.Input).stem().string();
+    const std::string stem = o.Input.empty() ? std::string("builtin") : std::filesystem::path(o.Input).stem().string();
     o.Output = stem + "_cage.vtp";
+  }
+}
+
+Options parseOptions(int argc, char* argv[], vtkSDFCageFilter* limits)
+{
+  Options o;
+  std::vector<std::string> positionals;
+  std::vector<std::string> buildOptions; // options that only make sense when building a cage
+  ArgumentCursor a(argc, argv);
+  while (a.next())
+  {
+    if (a.positional())
+    {
+      positionals.push_back(a.name());
+    }
+    else if (!parseCommonOption(a, o))
+    {
+      buildOptions.push_back(a.name());
+      if (!parseBuildOption(a, o, limits))
+      {
+        throw UsageError{ "unknown option '" + a.name() + "'" };
+      }
+    }
+  }
+  if (o.Check && !o.Help && !o.Version)
+  {
+    finishCheckOptions(o, positionals, buildOptions);
+  }
+  else
+  {
+    finishBuildOptions(o, positionals);
   }
   return o;
 }
@@ -553,7 +604,15 @@ int finish(const Options& o, RunReport& r, int code)
   return code;
 }
 
-int run(const Options& o, MessageCollector* messages)
+using Clock = std::chrono::steady_clock;
+
+double since(Clock::time_point start)
+{
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+/// What was asked, before anything runs.
+RunReport startReport(const Options& o)
 {
   RunReport r;
   r.InputFile = o.Input.empty() ? "builtin" : o.Input;
@@ -562,35 +621,18 @@ int run(const Options& o, MessageCollector* messages)
   r.VoxelSize = o.VoxelSize;
   r.MinimumClearance = o.Clearance;
   r.NumberOfThreads = o.Threads;
-  {
-    sdfcage::EnvelopeOptions resolved;
-    resolved.IsoValue = o.IsoValue;
-    resolved.MinimumClearance = o.Clearance;
-    r.MinimumClearanceUsed = resolved.clearance();
-  }
+  sdfcage::EnvelopeOptions resolved;
+  resolved.IsoValue = o.IsoValue;
+  resolved.MinimumClearance = o.Clearance;
+  r.MinimumClearanceUsed = resolved.clearance();
+  return r;
+}
 
-  if (!o.Screenshot.empty())
-  {
-    // fail before the long computation, not after it
-    std::string error;
-    if (!canRender(error))
-    {
-      printError(error);
-      r.Status = "RenderingUnavailable";
-      r.ErrorMessage = error;
-      return finish(o, r, ExitFailure);
-    }
-  }
-
-  vtkNew<ProgressBar> progress;
-  progress->Enabled = !o.Quiet && isatty(STDERR_FILENO);
-
-  // --- read ---
-  using Clock = std::chrono::steady_clock;
-  auto since = [](Clock::time_point start) {
-    return std::chrono::duration<double>(Clock::now() - start).count();
-  };
-  Clock::time_point start = Clock::now();
+/// --- read: the mesh file, or the built-in shape. Null (with the status in `r`) when the file
+/// cannot be read.
+vtkSmartPointer<vtkPolyData> readInput(const Options& o, RunReport& r, ProgressBar* progress, MessageCollector* messages)
+{
+  const Clock::time_point start = Clock::now();
   vtkSmartPointer<vtkPolyData> input;
   if (o.Input.empty())
   {
@@ -607,7 +649,7 @@ int run(const Options& o, MessageCollector* messages)
       printError(error);
       r.Status = "UnreadableInput";
       r.ErrorMessage = error;
-      return finish(o, r, ExitUnusable);
+      return nullptr;
     }
   }
   r.ReadTime = since(start);
@@ -615,124 +657,92 @@ int run(const Options& o, MessageCollector* messages)
   r.InputCells = input->GetNumberOfPolys() + input->GetNumberOfStrips();
   r.InputTriangles = triangleCount(input);
   flushWarnings(messages, o.Quiet, progress);
+  return input;
+}
 
-  // --- build the cage ---
-  vtkNew<vtkSDFCageFilter> filter;
-  filter->SetInputData(input);
+/// --- options: the command line on the filter (unset values keep the filter's defaults); the
+/// values used go to the report.
+void configureFilter(vtkSDFCageFilter* filter, const Options& o, RunReport& r)
+{
   filter->SetIsoValue(o.IsoValue);
   filter->SetVoxelSize(o.VoxelSize);
   filter->SetMinimumClearance(o.Clearance);
   if (o.Vertices >= 0)
-  {
     filter->SetTargetNumberOfVertices(o.Vertices);
-  }
   if (o.Adaptivity >= 0)
-  {
     filter->SetAdaptivity(o.Adaptivity);
-  }
   if (o.Refinements >= 0)
-  {
     filter->SetMaximumRefinements(o.Refinements);
-  }
   filter->SetUseActivePoints(o.NoActivePoints ? 0 : 1);
   if (o.ActiveRadius >= 0)
-  {
     filter->SetActiveRadius(o.ActiveRadius);
-  }
   if (o.GeodesicThreshold >= 0)
-  {
     filter->SetGeodesicThreshold(o.GeodesicThreshold);
-  }
   if (o.Alpha >= 0)
-  {
     filter->SetAmplificationAlpha(o.Alpha);
-  }
   if (o.Beta >= 0)
-  {
     filter->SetAmplificationBeta(o.Beta);
-  }
+  filter->SetOptimize(o.Optimize != "none");
+  if (o.Optimize == "spacing")
+    filter->SetEnergyToSpacing();
+  else
+    filter->SetEnergyToMIPS();
+  if (o.Spacing >= 0)
+    filter->SetTargetSpacing(o.Spacing);
+  if (o.Iterations >= 0)
+    filter->SetNumberOfIterations(o.Iterations);
+  filter->SetNumberOfThreads(o.Threads);
+  filter->SetSignMode(o.Sign == "flood" ? 1 : o.Sign == "winding" ? 2 : o.Sign == "unsigned" ? 3 : 0);
+
   r.UseActivePoints = filter->GetUseActivePoints() != 0;
   r.ActiveRadius = filter->GetActiveRadius();
   r.GeodesicThreshold = filter->GetGeodesicThreshold();
   r.AmplificationAlpha = filter->GetAmplificationAlpha();
   r.AmplificationBeta = filter->GetAmplificationBeta();
-  filter->SetOptimize(o.Optimize != "none");
-  if (o.Optimize == "spacing")
-  {
-    filter->SetEnergyToSpacing();
-  }
-  else
-  {
-    filter->SetEnergyToMIPS();
-  }
-  if (o.Spacing >= 0)
-  {
-    filter->SetTargetSpacing(o.Spacing);
-  }
-  if (o.Iterations >= 0)
-  {
-    filter->SetNumberOfIterations(o.Iterations);
-  }
   r.Optimize = o.Optimize;
   r.TargetSpacing = filter->GetTargetSpacing();
   r.NumberOfIterations = filter->GetNumberOfIterations();
   r.Adaptivity = filter->GetAdaptivity();
   r.TargetNumberOfVertices = filter->GetTargetNumberOfVertices();
   r.MaximumRefinements = filter->GetMaximumRefinements();
-  filter->SetNumberOfThreads(o.Threads);
-  filter->SetSignMode(o.Sign == "flood" ? 1 : o.Sign == "winding" ? 2 : o.Sign == "unsigned" ? 3 : 0);
   r.Sign = o.Sign;
+}
+
+/// --- run: the filter, with the progress bar; the first Ctrl-C cancels it cleanly.
+void runFilter(vtkSDFCageFilter* filter, ProgressBar* progress)
+{
   filter->AddObserver(vtkCommand::ProgressEvent, progress);
   std::signal(SIGINT, onInterrupt);
   filter->Update();
   std::signal(SIGINT, SIG_DFL);
+}
 
+/// --- results: the filter's status and every result of its table (by name), the mesh sizes.
+void collectResults(vtkSDFCageFilter* filter, RunReport& r)
+{
   vtkPolyData* cage = filter->GetOutput(0);
   vtkPolyData* envelope = vtkPolyData::SafeDownCast(filter->GetOutputDataObject(1));
   r.FilterRan = true;
   r.Status = filter->GetStatusString();
   r.ErrorMessage = filter->GetLastErrorMessage();
-  r.ValidationTime = filter->GetValidationTime();
-  r.DistanceFieldTime = filter->GetDistanceFieldTime();
-  r.IsosurfaceTime = filter->GetIsosurfaceTime();
-  r.VerificationTime = filter->GetVerificationTime();
-  r.SimplificationTime = filter->GetSimplificationTime();
-  r.CageVerificationTime = filter->GetCageVerificationTime();
-  r.OptimizationTime = filter->GetOptimizationTime();
-  r.EnergyBefore = filter->GetEnergyBefore();
-  r.EnergyAfter = filter->GetEnergyAfter();
-  r.VerticesReached = filter->GetVerticesReached();
-  r.TargetReached = filter->GetTargetReached();
-  r.StopReason = filter->GetStopReason();
-  r.EnvelopeComponents = filter->GetEnvelopeComponents();
-  r.TotalTime = filter->GetTotalTime();
-  r.MeasuredClearance = filter->GetMeasuredClearance();
-  r.MeasuredClearanceRelative = filter->GetMeasuredClearanceRelative();
-  r.EnclosureVerified = filter->GetEnclosureVerified();
-  r.RemovedPockets = filter->GetRemovedPockets();
-  r.EnvelopeGenus = filter->GetEnvelopeGenus();
-  r.VoxelSizeUsed = filter->GetVoxelSizeUsed();
-  r.InputWasFlipped = filter->GetInputWasFlipped();
-  r.NumberOfActivePoints = filter->GetNumberOfActivePoints();
-  r.ActivePointTime = filter->GetActivePointTime();
-  r.TopologyWarning = filter->GetTopologyWarning();
-  r.InputResults = sdfcage::inputResults(sdfcage::CageResult()); // the names and kinds
-  for (sdfcage::ResultField& f : r.InputResults)
+  for (sdfcage::ResultField& f : r.Results)
   {
     if (f.Type == sdfcage::ResultField::Kind::Text)
       f.Text = filter->GetResultText(f.Name.c_str());
-    else if (f.Type == sdfcage::ResultField::Kind::Real)
-      f.Real = filter->GetResultNumber(f.Name.c_str());
     else
-      f.Integer = static_cast<long long>(filter->GetResultNumber(f.Name.c_str()));
+      f.setNumber(filter->GetResultNumber(f.Name.c_str()));
   }
   r.CagePoints = cage ? cage->GetNumberOfPoints() : 0;
   r.CageTriangles = cage ? triangleCount(cage) : 0;
   r.EnvelopePoints = envelope ? envelope->GetNumberOfPoints() : 0;
   r.EnvelopeTriangles = envelope ? triangleCount(envelope) : 0;
-  // The filter reports its errors through GetLastErrorMessage(): VTK's copy of them is not
-  // printed again, warnings are.
-  if (!o.Quiet && !messages->warnings().empty())
+}
+
+/// Prints VTK's warnings of the run (unless quiet) and returns its errors. The filter reports
+/// its errors through GetLastErrorMessage(): VTK's copy of them is not printed again.
+std::vector<std::string> takeFilterMessages(MessageCollector* messages, bool quiet, ProgressBar* progress)
+{
+  if (!quiet && !messages->warnings().empty())
   {
     progress->finish(); // warnings go on lines of their own
     for (const std::string& w : messages->warnings())
@@ -740,104 +750,162 @@ int run(const Options& o, MessageCollector* messages)
       std::cerr << Program << ": warning: " << w << "\n";
     }
   }
-  const std::vector<std::string> filterErrors = messages->errors();
+  const std::vector<std::string> errors = messages->errors();
   messages->clear();
-  if (r.Status != "Ok" || !r.EnclosureVerified)
-  {
-    progress->finish();
-  }
+  return errors;
+}
 
+/// The outcomes that end the run before writing anything: interrupted, unusable input, a
+/// failure of the filter. -1 when the run goes on.
+int stopCode(const Options& o, RunReport& r, const std::vector<std::string>& filterErrors)
+{
   if (InterruptRequested || r.Status == "Cancelled")
   {
     printError("interrupted");
     r.ErrorMessage = r.ErrorMessage.empty() ? "interrupted" : r.ErrorMessage;
-    return finish(o, r, ExitInterrupted);
+    return ExitInterrupted;
   }
   if (r.Status == "InvalidInput" || r.Status == "EmptyInput")
   {
     const std::string why = !r.ErrorMessage.empty() ? r.ErrorMessage
       : r.Status == "EmptyInput"                    ? std::string("the input has no triangles")
                                                     : std::string("the input is not usable");
-    printError((o.Input.empty() ? std::string("the built-in shape") : "'" + o.Input + "'") +
-      ": " + why);
+    printError((o.Input.empty() ? std::string("the built-in shape") : "'" + o.Input + "'") + ": " + why);
     r.ErrorMessage = why;
-    return finish(o, r, ExitUnusable);
+    return ExitUnusable;
   }
   if (r.Status != "Ok" && r.Status != "VerificationFailed")
   {
     std::string why = r.ErrorMessage;
     if (why.empty())
     {
-      why = !filterErrors.empty() ? filterErrors.front()
-                                  : "the cage filter failed (status '" + r.Status + "')";
+      why = !filterErrors.empty() ? filterErrors.front() : "the cage filter failed (status '" + r.Status + "')";
     }
     printError(why);
     r.ErrorMessage = why;
-    return finish(o, r, ExitFailure);
+    return ExitFailure;
   }
+  return -1;
+}
 
-  int code = ExitOk;
-  const bool verified = r.Status == "Ok" && r.EnclosureVerified && r.CageTriangles > 0;
-  if (!verified)
+/// --- write: the cage file. False (with the status in `r`) when it cannot be written.
+bool writeCage(vtkPolyData* cage, const Options& o, RunReport& r, ProgressBar* progress)
+{
+  const Clock::time_point start = Clock::now();
+  progress->step("writing " + std::filesystem::path(o.Output).filename().string(), 1.0);
+  std::string error;
+  if (!writeMesh(cage, o.Output, error))
   {
-    code = ExitNotVerified;
-    std::string why = r.ErrorMessage.empty() ? "the enclosure could not be verified"
-                                             : r.ErrorMessage;
-    printError(why + " (no cage written)");
-    r.ErrorMessage = why;
+    progress->finish();
+    printError(error);
+    r.Status = "WriteFailed";
+    r.ErrorMessage = error;
+    return false;
+  }
+  r.WriteTime = since(start);
+  r.OutputFile = o.Output;
+  return true;
+}
+
+/// --- picture: input and cage (or the unverified envelope, to inspect it) as a PNG. Returns
+/// the exit code, made ExitFailure when rendering fails on an otherwise good run.
+int writePicture(vtkPolyData* input, vtkPolyData* shown, bool verified, const Options& o, RunReport& r,
+  ProgressBar* progress, MessageCollector* messages, int code)
+{
+  std::string title = std::string("SDFCage: ") +
+    (o.Input.empty() ? std::string("built-in shape") : std::filesystem::path(o.Input).filename().string()) +
+    (verified ? " and its cage (" : " and its UNVERIFIED envelope (") +
+    std::to_string(shown ? triangleCount(shown) : 0) + " triangles, clearance " +
+    shortNumber(r.number("MeasuredClearanceRelative")) + " relative)";
+  progress->step("rendering " + std::filesystem::path(o.Screenshot).filename().string(), 1.0);
+  std::string error;
+  if (!writeScreenshot(input, shown, title, o.Screenshot, error))
+  {
+    progress->finish();
+    printError(error);
+    if (code == ExitOk)
+    {
+      r.Status = "ScreenshotFailed";
+      r.ErrorMessage = error;
+      code = ExitFailure;
+    }
   }
   else
   {
-    // --- write ---
-    start = Clock::now();
-    progress->step("writing " + std::filesystem::path(o.Output).filename().string(), 1.0);
+    r.ScreenshotFile = o.Screenshot;
+  }
+  flushWarnings(messages, o.Quiet, progress);
+  return code;
+}
+
+/// One cage: read -> options -> run -> results -> write -> picture -> summary and report.
+int run(const Options& o, MessageCollector* messages)
+{
+  RunReport r = startReport(o);
+  if (!o.Screenshot.empty())
+  {
+    // fail before the long computation, not after it
     std::string error;
-    if (!writeMesh(cage, o.Output, error))
+    if (!canRender(error))
     {
-      progress->finish();
       printError(error);
-      r.Status = "WriteFailed";
+      r.Status = "RenderingUnavailable";
       r.ErrorMessage = error;
       return finish(o, r, ExitFailure);
     }
-    r.WriteTime = since(start);
-    r.OutputFile = o.Output;
+  }
+  vtkNew<ProgressBar> progress;
+  progress->Enabled = !o.Quiet && isatty(STDERR_FILENO);
+
+  vtkSmartPointer<vtkPolyData> input = readInput(o, r, progress, messages);
+  if (!input)
+  {
+    return finish(o, r, ExitUnusable);
+  }
+  vtkNew<vtkSDFCageFilter> filter;
+  filter->SetInputData(input);
+  configureFilter(filter, o, r);
+  runFilter(filter, progress);
+  collectResults(filter, r);
+  const std::vector<std::string> filterErrors = takeFilterMessages(messages, o.Quiet, progress);
+  if (r.Status != "Ok" || !r.flag("EnclosureVerified"))
+  {
+    progress->finish();
+  }
+  const int stop = stopCode(o, r, filterErrors);
+  if (stop >= 0)
+  {
+    return finish(o, r, stop);
   }
 
-  // --- picture (also of an unverified envelope, to inspect it) ---
+  int code = ExitOk;
+  vtkPolyData* cage = filter->GetOutput(0);
+  const bool verified = r.Status == "Ok" && r.flag("EnclosureVerified") && r.CageTriangles > 0;
+  if (!verified)
+  {
+    code = ExitNotVerified;
+    const std::string why = r.ErrorMessage.empty() ? "the enclosure could not be verified" : r.ErrorMessage;
+    printError(why + " (no cage written)");
+    r.ErrorMessage = why;
+  }
+  else if (!writeCage(cage, o, r, progress))
+  {
+    return finish(o, r, ExitFailure);
+  }
   if (!o.Screenshot.empty())
   {
-    vtkPolyData* shown = verified ? cage : envelope;
-    std::string title = std::string("SDFCage: ") +
-      (o.Input.empty() ? std::string("built-in shape")
-                       : std::filesystem::path(o.Input).filename().string()) +
-      (verified ? " and its cage (" : " and its UNVERIFIED envelope (") +
-      std::to_string(shown ? triangleCount(shown) : 0) + " triangles, clearance " +
-      shortNumber(r.MeasuredClearanceRelative) + " relative)";
-    progress->step("rendering " + std::filesystem::path(o.Screenshot).filename().string(), 1.0);
-    std::string error;
-    if (!writeScreenshot(input, shown, title, o.Screenshot, error))
-    {
-      progress->finish();
-      printError(error);
-      if (code == ExitOk)
-      {
-        r.Status = "ScreenshotFailed";
-        r.ErrorMessage = error;
-        code = ExitFailure;
-      }
-    }
-    else
-    {
-      r.ScreenshotFile = o.Screenshot;
-    }
-    flushWarnings(messages, o.Quiet, progress);
+    vtkPolyData* envelope = vtkPolyData::SafeDownCast(filter->GetOutputDataObject(1));
+    code = writePicture(input, verified ? cage : envelope, verified, o, r, progress, messages, code);
   }
 
   progress->finish();
   if (!o.Quiet)
   {
     printSummary(std::cout, r);
+    if (o.Verbose)
+    {
+      printResults(std::cout, r.Results);
+    }
     std::cout.flush();
   }
   return finish(o, r, code);

@@ -147,7 +147,7 @@ int main(int argc, char** argv)
     {
       double t = 0;
       value(t);
-      options.Envelope.NumberOfThreads = static_cast<int>(t);
+      options.NumberOfThreads = static_cast<int>(t);
     }
     else if (a == "-h" || a == "--help")
     {
@@ -190,7 +190,7 @@ int main(int argc, char** argv)
   std::printf("c = %g, voxel = %g, adaptivity = %g, active points %s (r %g), target vertices = %d, threads = %d (0 = all)\n\n",
     options.Envelope.IsoValue, options.Envelope.voxelSize(), options.Envelope.Adaptivity,
     options.Envelope.UseActivePoints ? "on" : "off", options.Envelope.ActivePoints.Radius,
-    options.TargetNumberOfVertices, options.Envelope.NumberOfThreads);
+    options.TargetNumberOfVertices, options.NumberOfThreads);
   std::printf("| mesh | faces | read s | validate s | active pts (samples) | active + φξ s | SDF s | isosurface s | verify s | envelope stage s | "
               "envelope tris | simplify s | cage verify s | total s | cage verts | clearance (unit) | "
               "Hausdorff cage→input (/diag) | genus in→env→cage | pockets | peak MB | verified |\n");

@@ -45,7 +45,7 @@ int run(const std::string& name, const PolygonMesh& polygons, int vertices, int 
   const TriangleMesh envelope = n.toUnit(full.Envelope);
   const TriangleTree tree(unit);
   SimplifyOptions so = options.Simplify;
-  so.TargetVertices = vertices;
+  so.TargetNumberOfVertices = vertices;
   so.Clearance = options.Envelope.clearance();
   double best = 1e300;
   SimplifyResult r;
@@ -58,7 +58,7 @@ int run(const std::string& name, const PolygonMesh& polygons, int vertices, int 
               "%.1f us/collapse; collapses %lld, rejected input %lld self %lld topology %lld shape "
               "%lld, relocated %lld\n",
     name.c_str(), envelope.Triangles.size(), r.VerticesReached, vertices,
-    r.ReachedTarget ? "" : ", not reached", repeat, best, 1e6 * best / std::max(1LL, r.Collapses),
+    r.TargetReached ? "" : ", not reached", repeat, best, 1e6 * best / std::max(1LL, r.Collapses),
     r.Collapses, r.RejectedInput, r.RejectedSelf, r.RejectedTopology, r.RejectedShape, r.Relocated);
   std::fflush(stdout);
   return 0;

@@ -6,8 +6,11 @@
 #         [-DEXPECT_FILES="f1|f2"] [-DEXPECT_NO_FILES="f1|f2"]
 #         [-DREPORT=<json>] [-DEXPECT_JSON="Key=value|Key=value"] [-DPYTHON=<python>
 #         -DPNG_CHECK=<check_png.py> -DPNG=<file>]
-#         [-DEXACT_CHECK=<sdfcage_exact_check> -DEXACT_FILES="input|cage"] -P RunCLI.cmake
+#         [-DEXACT_CHECK=<sdfcage_exact_check> -DEXACT_FILES="input|cage"]
+#         [-DRESULTS_IN_JSON=ON] -P RunCLI.cmake
 #
+# RESULTS_IN_JSON: the run was --verbose; every result it lists after "results:" (the whole
+# results table, as the program knows it) must be a key of the JSON report.
 # Lists use "|" (a ";" would be split by the command line). Relative file names are in WORKDIR,
 # which is emptied first. SETUP writes a small mesh there (see below). Prints "SKIPPED: ..."
 # (a skip for CTest) when PREFIX names a program that is not installed.
@@ -249,6 +252,27 @@ if (DEFINED REPORT)
             list(APPEND failures "report ${key} = '${value}', expected > ${expected}")
           endif ()
         endforeach ()
+      endif ()
+      if (RESULTS_IN_JSON)
+        string(FIND "${out}" "\nresults:\n" at)
+        if (at EQUAL -1)
+          list(APPEND failures "stdout has no 'results:' list (run with --verbose)")
+        else ()
+          string(SUBSTRING "${out}" ${at} -1 listing)
+          string(REGEX MATCHALL "\n  [A-Za-z0-9]+ +=" lines "${listing}")
+          list(LENGTH lines n)
+          if (n LESS 50)
+            list(APPEND failures "only ${n} results listed after 'results:'")
+          endif ()
+          foreach (line IN LISTS lines)
+            string(REGEX REPLACE "^\n  ([A-Za-z0-9]+) +=$" "\\1" key "${line}")
+            string(JSON value ERROR_VARIABLE keyError GET "${json}" "${key}")
+            if (keyError)
+              list(APPEND failures "the result ${key} is not in the report")
+            endif ()
+          endforeach ()
+          message("${n} results listed, each one a key of the report")
+        endif ()
       endif ()
       # the output named in the report exists
       string(JSON output ERROR_VARIABLE keyError GET "${json}" OutputFile)

@@ -298,8 +298,8 @@ TEST(Optimization, DeterministicAcrossThreadCounts)
   a.Optimization.Energy = CageEnergy::Spacing;
   a.Optimization.TargetSpacing = 0.03;
   CageOptions b = a;
-  a.Envelope.NumberOfThreads = 1;
-  b.Envelope.NumberOfThreads = 2;
+  a.NumberOfThreads = 1;
+  b.NumberOfThreads = 2;
   const CageResult ra = generateCage(PolygonMesh::fromTriangles(input), a);
   const CageResult rb = generateCage(PolygonMesh::fromTriangles(input), b);
   ASSERT_EQ(ra.State, Status::Ok) << ra.Message;

@@ -136,7 +136,7 @@ TEST(Simplification, PlainQEMFailsWhereConstrainedPasses)
     ASSERT_EQ(env.State, Status::Ok) << env.Message;
     const TriangleTree tree(unit);
     SimplifyOptions so;
-    so.TargetVertices = 40;
+    so.TargetNumberOfVertices = 40;
     so.Clearance = eo.clearance();
     SimplifyOptions plain = so;
     plain.EnforceClearance = false;
@@ -163,8 +163,8 @@ TEST(Simplification, DeterministicAcrossThreadCounts)
   const TriangleMesh input = makeBuiltinShape();
   CageOptions a, b;
   a.TargetNumberOfVertices = b.TargetNumberOfVertices = 400;
-  a.Envelope.NumberOfThreads = 1;
-  b.Envelope.NumberOfThreads = 2;
+  a.NumberOfThreads = 1;
+  b.NumberOfThreads = 2;
   const CageResult ra = generateCage(PolygonMesh::fromTriangles(input), a);
   const CageResult rb = generateCage(PolygonMesh::fromTriangles(input), b);
   ASSERT_EQ(ra.State, Status::Ok);

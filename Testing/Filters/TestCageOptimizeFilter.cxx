@@ -76,6 +76,18 @@ int TestOptimizeFilter(const Context&)
     auto* status = vtkStringArray::SafeDownCast(out->GetFieldData()->GetAbstractArray("Status"));
     c.Check(status && status->GetValue(0) == "Ok", name + ": field data Status");
     c.Check(out->GetFieldData()->GetArray("EnergyAfter") != nullptr, name + ": field data EnergyAfter");
+    // every result of the filter's table is in the field data, with the getter's value
+    c.Check(filter->GetNumberOfResults() >= 11, name + ": the optimization table has its 11 results");
+    for (int i = 0; i < filter->GetNumberOfResults(); ++i)
+    {
+      const std::string result = filter->GetResultName(i);
+      vtkDataArray* a = out->GetFieldData()->GetArray(result.c_str());
+      c.Check(a && a->GetNumberOfTuples() == 1 && a->GetTuple1(0) == filter->GetResultNumber(result.c_str()),
+        name + ": field data " + result + " = the getter's");
+    }
+    c.Check(filter->GetEnergyAfter() == filter->GetResultNumber("EnergyAfter") &&
+        filter->GetNumberOfMoves() == filter->GetResultNumber("NumberOfMoves"),
+      name + ": the getters read the table");
     c.Check(filter->GetOptimizationTime() > 0, name + ": time measured");
   }
   c.Check(messages->Errors.empty(), "no errors");

@@ -94,6 +94,19 @@ int TestQualityGoodCube(const Context&)
   c.Check(messages->Errors.empty(), "no error");
   c.Check(quality->GetEncloses(), "a cube of side 3 encloses the unit sphere: " + std::string(quality->GetQualityMessage()));
   c.Check(FieldValue(out, "Encloses") == 1, "field data Encloses = 1");
+  // every result of the filter's table is in the field data, with the getter's value
+  c.Check(quality->GetNumberOfResults() >= 18, "the quality table has its 18 results");
+  for (int i = 0; i < quality->GetNumberOfResults(); ++i)
+  {
+    const char* name = quality->GetResultName(i);
+    vtkAbstractArray* a = out->GetFieldData()->GetAbstractArray(name);
+    c.Check(a != nullptr && a->GetNumberOfTuples() == 1, std::string("field data has ") + name);
+    if (vtkStringArray::SafeDownCast(a))
+      c.Check(FieldText(out, name) == quality->GetResultText(name), std::string("field data ") + name + " = the getter's");
+    else
+      c.Check(FieldValue(out, name) == quality->GetResultNumber(name), std::string("field data ") + name + " = the getter's");
+  }
+  c.Check(quality->GetHausdorffCageToInput() == FieldValue(out, "HausdorffCageToInput"), "GetHausdorffCageToInput reads the table");
   c.Check(out->GetNumberOfCells() == 6 && out->GetNumberOfPoints() == 8, "output is the cage (6 quads, 8 points)");
   // vtkSphereSource puts no vertex on the x and y axes: the clearance is at least 0.5
   c.Check(quality->GetMinimumClearance() >= 0.5 && quality->GetMinimumClearance() < 0.52,

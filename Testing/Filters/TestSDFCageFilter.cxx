@@ -25,6 +25,9 @@
 #include "vtkTriangleFilter.h"
 
 #include "Pipeline/CageGenerator.h" // Core: the default options the filter must mirror
+#include "Envelope/ActivePointAnalysis.h"
+#include "Pipeline/Results.h"       // Core: the results table every result must travel by
+#include "vtkIdTypeArray.h"
 #include "Mesh/Shapes.h"   // Core: the built-in test shape
 
 #include <algorithm>
@@ -95,6 +98,69 @@ bool IsEmpty(vtkDataObject* data)
     return image->GetNumberOfPoints() == 0;
   }
   return data == nullptr;
+}
+
+/// Every result of Core's table is in the cage's field data, as an array of its kind, with the
+/// value of the filter's getter by name, and the filter lists the table in its order: a result
+/// added to the table cannot be forgotten on the way out. Holds whatever the outcome.
+void CheckResultsTable(Checker& c, vtkSDFCageFilter* filter)
+{
+  vtkPolyData* cage = filter->GetOutput(0);
+  vtkFieldData* fd = cage->GetFieldData();
+  const sdfcage::ResultTable table = sdfcage::cageResults(sdfcage::CageResult());
+  c.Check(filter->GetNumberOfResults() == static_cast<int>(table.size()),
+    "the filter has every result of the table (" + Str(table.size()) + ")");
+  int missing = 0;
+  for (std::size_t i = 0; i < table.size(); ++i)
+  {
+    const sdfcage::ResultField& f = table[i];
+    const char* name = f.Name.c_str();
+    if (std::string(filter->GetResultName(static_cast<int>(i))) != f.Name)
+    {
+      c.Check(false, "result " + Str(i) + " is " + f.Name + ", the filter says " + filter->GetResultName(static_cast<int>(i)));
+    }
+    vtkAbstractArray* array = fd->GetAbstractArray(name);
+    if (!array || array->GetNumberOfTuples() != 1)
+    {
+      ++missing;
+      c.Check(false, std::string("field data has one value of ") + name);
+      continue;
+    }
+    switch (f.Type)
+    {
+      case sdfcage::ResultField::Kind::Text:
+        c.Check(vtkStringArray::SafeDownCast(array) != nullptr && FieldString(cage, name) == filter->GetResultText(name),
+          std::string("field data ") + name + " is the text of GetResultText");
+        break;
+      case sdfcage::ResultField::Kind::Flag:
+        c.Check(vtkIntArray::SafeDownCast(array) != nullptr &&
+            (FieldNumber(cage, name) == 0 || FieldNumber(cage, name) == 1),
+          std::string("field data ") + name + " is an int flag");
+        break;
+      case sdfcage::ResultField::Kind::Integer:
+        c.Check(vtkIdTypeArray::SafeDownCast(array) != nullptr, std::string("field data ") + name + " is a vtkIdTypeArray");
+        break;
+      case sdfcage::ResultField::Kind::Real:
+        c.Check(vtkDoubleArray::SafeDownCast(array) != nullptr, std::string("field data ") + name + " is a vtkDoubleArray");
+        break;
+    }
+    if (f.Type != sdfcage::ResultField::Kind::Text && FieldNumber(cage, name) != filter->GetResultNumber(name))
+    {
+      c.Check(false, std::string("field data ") + name + " = " + Str(FieldNumber(cage, name)) +
+          ", GetResultNumber gives " + Str(filter->GetResultNumber(name)));
+    }
+  }
+  c.Check(missing == 0, "every result of the table is in the field data");
+  // the old getters read the same table
+  c.Check(filter->GetMeasuredClearance() == filter->GetResultNumber("MeasuredClearance"), "GetMeasuredClearance = the table's");
+  c.Check(filter->GetVerticesReached() == filter->GetResultNumber("VerticesReached"), "GetVerticesReached = the table's");
+  c.Check(filter->GetEnclosureVerified() == (filter->GetResultNumber("EnclosureVerified") == 1), "GetEnclosureVerified = the table's");
+  c.Check(filter->GetNumberOfActivePoints() == filter->GetResultNumber("NumberOfActivePoints"), "GetNumberOfActivePoints = the table's");
+  c.Check(filter->GetTotalTime() == filter->GetResultNumber("TotalTime"), "GetTotalTime = the table's");
+  c.Check(std::string(filter->GetStopReason()) == filter->GetResultText("StopReason"), "GetStopReason = the table's");
+  c.Check(std::string(filter->GetResultName(-1)).empty() && filter->GetResultNumber("NoSuchResult") == 0 &&
+      std::string(filter->GetResultText("NoSuchResult")).empty(),
+    "unknown names and indices give nothing");
 }
 
 /// Everything a successful run must satisfy: a closed cage and envelope around the input, with
@@ -187,6 +253,7 @@ void CheckSuccessfulRun(Checker& c, vtkSDFCageFilter* filter, vtkPolyData* input
   {
     c.Check(IsEmpty(filter->GetOutputDataObject(2)), "no distance field unless requested");
   }
+  CheckResultsTable(c, filter);
 }
 
 void PrintResults(vtkSDFCageFilter* filter)
@@ -401,6 +468,8 @@ int TestNoSurface(const Context&)
   std::cout << "  error: " << (messages->Errors.empty() ? "(none)" : messages->Errors[0]) << "\n";
   c.Check(messages->ErrorContains("no polygons"), "a point cloud is rejected (no polygons)");
   c.Check(IsEmpty(filter->GetOutput(0)), "empty cage");
+  c.Check(FieldString(filter->GetOutput(0), "Status") == "InvalidInput", "field data Status InvalidInput");
+  CheckResultsTable(c, filter);
   return c.Result();
 }
 
@@ -418,6 +487,8 @@ int TestEmptyInput(const Context&)
   filter->Update();
   c.Check(messages->Errors.empty() && messages->Warnings.empty(), "no error or warning");
   c.Check(std::string(filter->GetStatusString()) == "EmptyInput", "status EmptyInput");
+  CheckResultsTable(c, filter); // a run that did not happen still publishes every result
+  c.Check(std::string(filter->GetResultText("SignMode")).empty(), "no inside rule decided");
   for (int port = 0; port < 3; ++port)
   {
     c.Check(IsEmpty(filter->GetOutputDataObject(port)), "output " + Str(port) + " is empty");
@@ -630,7 +701,7 @@ int TestParameters(const Context&)
     "MaximumRefinements default = Core's");
   c.Check((filter->GetGenerateDistanceField() != 0) == core.KeepDistanceField,
     "GenerateDistanceField default = Core's");
-  c.Check(filter->GetNumberOfThreads() == core.NumberOfThreads, "NumberOfThreads default = Core's");
+  c.Check(filter->GetNumberOfThreads() == sdfcage::CageOptions().NumberOfThreads, "NumberOfThreads default = Core's");
   c.Check(filter->GetIsoValue() == 0.01, "IsoValue default is the paper's 0.01");
   c.Check(filter->GetTargetNumberOfVertices() == sdfcage::CageOptions().TargetNumberOfVertices,
     "TargetNumberOfVertices default = Core's");
@@ -790,6 +861,15 @@ int TestActivePointsBuiltin(const Context&)
   c.Check(count == filter->GetNumberOfActivePoints(), "GetNumberOfActivePoints counts them");
   c.Check(count < out->GetNumberOfPoints() / 2, "most points are not active");
   c.Check(FieldNumber(out, "NumberOfActivePoints") == static_cast<double>(count), "field data NumberOfActivePoints");
+  const sdfcage::ResultTable table = sdfcage::activePointResults(sdfcage::ActivePointAnalysis());
+  c.Check(filter->GetNumberOfResults() == static_cast<int>(table.size()), "the filter has Core's active-point table");
+  for (const sdfcage::ResultField& f : table)
+  {
+    c.Check(FieldNumber(out, f.Name.c_str()) == filter->GetResultNumber(f.Name.c_str()),
+      "field data " + f.Name + " = GetResultNumber");
+  }
+  c.Check(filter->GetExecutionTime() == FieldNumber(out, "ActivePointTime") && filter->GetActivePointTime() > 0,
+    "GetExecutionTime (old name) = GetActivePointTime = field data ActivePointTime");
   auto* fields = vtkImageData::SafeDownCast(filter->GetOutputDataObject(1));
   c.Check(fields && fields->GetNumberOfPoints() > 1000, "output 1 holds the fields");
   if (fields)

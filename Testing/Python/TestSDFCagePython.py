@@ -71,6 +71,18 @@ def test_filter():
     fd = cage.GetFieldData()
     check(fd.GetAbstractArray("Status").GetValue(0) == "Ok", "field data Status")
     check(fd.GetArray("TotalTime").GetValue(0) > 0, "field data TotalTime")
+    # every result of the filter's table, listed by name, is in the field data with its value
+    names = [f.GetResultName(i) for i in range(f.GetNumberOfResults())]
+    check(len(names) >= 50 and len(set(names)) == len(names), "%d results, unique names" % len(names))
+    for name in names:
+        a = fd.GetAbstractArray(name)
+        if a is None:
+            check(False, "field data has the result " + name)
+        elif a.IsA("vtkStringArray"):
+            check(a.GetValue(0) == f.GetResultText(name), "field data %s = GetResultText" % name)
+        else:
+            check(a.GetTuple1(0) == f.GetResultNumber(name), "field data %s = GetResultNumber" % name)
+    check(f.GetResultNumber("VerticesReached") == f.GetVerticesReached(), "GetVerticesReached reads the table")
     image = f.GetOutputDataObject(2)
     check(image.IsA("vtkImageData") and image.GetNumberOfPoints() > 0, "distance field image")
     sd = image.GetPointData().GetArray("SignedDistance")
