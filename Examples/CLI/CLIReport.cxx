@@ -248,6 +248,12 @@ void printSummary(std::ostream& os, const RunReport& r)
   os << "\n";
   os << "voxel size  : " << number(r.number("VoxelSizeUsed")) << " (relative: the input scaled into the "
      << "unit sphere), isovalue " << number(r.IsoValue) << ", adaptivity " << number(r.Adaptivity) << "\n";
+  if (r.integer("EnvelopeWidenings") > 0)
+  {
+    os << "widened     : " << r.integer("EnvelopeWidenings") << " time(s), to isovalue "
+       << number(r.number("IsoValueUsed")) << " (the input has no defined topology and the target "
+       << "needed it): " << r.text("WideningLog") << "\n";
+  }
   os << "timings     : validation " << seconds(r.number("ValidationTime")) << ", distance field "
      << seconds(r.number("DistanceFieldTime")) << ", active points " << seconds(r.number("ActivePointTime"))
      << ", isosurface " << seconds(r.number("IsosurfaceTime")) << ", verification "
