@@ -33,9 +33,6 @@ namespace
 {
 
 constexpr double Inf = std::numeric_limits<double>::infinity();
-// Neighbouring cage triangles whose dihedral angle closes below ~18 degrees count as folded (the
-// simplifier's threshold).
-constexpr double FoldCosine = -0.95;
 // Bisection steps of the continuous collision detection when a whole move is not clear.
 constexpr int BisectionSteps = 10;
 // Sufficient-decrease fraction of the line search (Armijo condition).
@@ -151,7 +148,7 @@ LocalChangePolicy changePolicy(const OptimizeOptions& o, double clearance, doubl
   p.MinimumTriangleQuality = o.MinimumTriangleQuality;
   p.KeepQualityBefore = true;
   p.MinimumNormalCosine = 0.0;
-  p.FoldCosine = FoldCosine;
+  // FoldCosine: the default, the simplifier's
   p.Clearance = clearance;
   // a move's input clearance is established by the collision-free sweep (sweepClear)
   p.Input = move ? LocalChangePolicy::InputTest::None : LocalChangePolicy::InputTest::Exact;

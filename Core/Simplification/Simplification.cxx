@@ -12,7 +12,6 @@
 #include <cstdint>
 #include <limits>
 #include <queue>
-#include <unordered_map>
 #include <unordered_set>
 
 #include <tbb/enumerable_thread_specific.h>
