@@ -8,6 +8,46 @@
 namespace sdfcage
 {
 
+namespace
+{
+
+inline bool separatedImpl(const Vec3 a[3], const Vec3 b[3], const Vec3& u, double gap)
+{
+  const double n = u.norm();
+  if (!(n > 0))
+    return false;
+  const double a0 = u.dot(a[0]), a1 = u.dot(a[1]), a2 = u.dot(a[2]);
+  const double b0 = u.dot(b[0]), b1 = u.dot(b[1]), b2 = u.dot(b[2]);
+  const double g = gap * n * (1 + 1e-9);
+  return std::min({ b0, b1, b2 }) - std::max({ a0, a1, a2 }) >= g ||
+    std::min({ a0, a1, a2 }) - std::max({ b0, b1, b2 }) >= g;
+}
+
+inline bool oneSideImpl(const Vec3& a, const Vec3& n, const Vec3& d, const Vec3& e)
+{
+  const Vec3 ad = d - a, ae = e - a;
+  const double sd = n.dot(ad), se = n.dot(ae);
+  const double nn = n.norm();
+  const double td = 1e-6 * nn * ad.norm(), te = 1e-6 * nn * ae.norm();
+  return (sd > td && se > te) || (sd < -td && se < -te);
+}
+
+inline bool separatedByAxesImpl(const ChangedTriangle& a, const LocalChangeScratch::Candidate& b, double gap)
+{
+  if (separatedImpl(a.Pts, b.Pts, b.C - a.C, gap) || separatedImpl(a.Pts, b.Pts, a.N, gap))
+    return true;
+  const Vec3 nb = (b.Pts[1] - b.Pts[0]).cross(b.Pts[2] - b.Pts[0]);
+  if (separatedImpl(a.Pts, b.Pts, nb, gap))
+    return true;
+  for (int k = 0; k < 3; ++k)
+    if (separatedImpl(a.Pts, b.Pts, a.N.cross(a.Pts[(k + 1) % 3] - a.Pts[k]), gap) ||
+      separatedImpl(a.Pts, b.Pts, nb.cross(b.Pts[(k + 1) % 3] - b.Pts[k]), gap))
+      return true;
+  return false;
+}
+
+} // namespace
+
 const char* verdictName(LocalChangeVerdict v)
 {
   switch (v)
@@ -165,15 +205,14 @@ bool LocalChangeVeto::selfIntersectionFree(LocalChangeScratch& s, LocalChangeFin
     }
     if ((c.Lo.array() > ringHi.array()).any() || (c.Hi.array() < ringLo.array()).any())
       return;
-    c.C = (c.Pts[0] + c.Pts[1] + c.Pts[2]) / 3.0;
-    c.R = std::max({ (c.Pts[0] - c.C).norm(), (c.Pts[1] - c.C).norm(), (c.Pts[2] - c.C).norm() });
+    c.R = -1; // the bounding sphere when first needed
     candidates.push_back(c);
   });
   for (const ChangedTriangle& nt : s.Tris)
   {
     const Vec3 lo = nt.Pts[0].cwiseMin(nt.Pts[1]).cwiseMin(nt.Pts[2]) - Vec3::Constant(selfDelta);
     const Vec3 hi = nt.Pts[0].cwiseMax(nt.Pts[1]).cwiseMax(nt.Pts[2]) + Vec3::Constant(selfDelta);
-    for (const auto& c : candidates)
+    for (auto& c : candidates)
     {
       if ((c.Lo.array() > hi.array()).any() || (c.Hi.array() < lo.array()).any())
         continue;
@@ -191,14 +230,19 @@ bool LocalChangeVeto::selfIntersectionFree(LocalChangeScratch& s, LocalChangeFin
       // strictly on one side of the other's plane (by an angle far above rounding, so
       // meetBeyondSharedVertex's nearly-coplanar case cannot apply)
       if (shared == 1 &&
-        (oneSide(nt.Pts[ka], nt.N, c.Pts[(kb + 1) % 3], c.Pts[(kb + 2) % 3]) ||
-          oneSide(c.Pts[kb], (c.Pts[1] - c.Pts[0]).cross(c.Pts[2] - c.Pts[0]), nt.Pts[(ka + 1) % 3], nt.Pts[(ka + 2) % 3])))
+        (oneSideImpl(nt.Pts[ka], nt.N, c.Pts[(kb + 1) % 3], c.Pts[(kb + 2) % 3]) ||
+          oneSideImpl(c.Pts[kb], (c.Pts[1] - c.Pts[0]).cross(c.Pts[2] - c.Pts[0]), nt.Pts[(ka + 1) % 3], nt.Pts[(ka + 2) % 3])))
         continue;
+      if (disjoint && c.R < 0)
+      {
+        c.C = (c.Pts[0] + c.Pts[1] + c.Pts[2]) / 3.0;
+        c.R = std::max({ (c.Pts[0] - c.C).norm(), (c.Pts[1] - c.C).norm(), (c.Pts[2] - c.C).norm() });
+      }
       // disjoint triangles whose bounding spheres are farther apart than selfDelta cannot conflict
       if (disjoint && (c.C - nt.C).norm() - c.R - nt.R >= selfDelta)
         continue;
       // nor those a separating axis keeps selfDelta apart
-      if (disjoint && separatedByAxes(nt, c, selfDelta))
+      if (disjoint && separatedByAxesImpl(nt, c, selfDelta))
         continue;
       if (!trianglesConflict(nt.Ids, nt.Pts, c.Ids, c.Pts, selfDelta, Policy.FoldCosine))
         continue;
@@ -216,37 +260,17 @@ bool LocalChangeVeto::selfIntersectionFree(LocalChangeScratch& s, LocalChangeFin
 
 bool LocalChangeVeto::separated(const Vec3 a[3], const Vec3 b[3], const Vec3& u, double gap)
 {
-  const double n = u.norm();
-  if (!(n > 0))
-    return false;
-  const double a0 = u.dot(a[0]), a1 = u.dot(a[1]), a2 = u.dot(a[2]);
-  const double b0 = u.dot(b[0]), b1 = u.dot(b[1]), b2 = u.dot(b[2]);
-  const double g = gap * n * (1 + 1e-9);
-  return std::min({ b0, b1, b2 }) - std::max({ a0, a1, a2 }) >= g ||
-    std::min({ a0, a1, a2 }) - std::max({ b0, b1, b2 }) >= g;
+  return separatedImpl(a, b, u, gap);
 }
 
 bool LocalChangeVeto::oneSide(const Vec3& a, const Vec3& n, const Vec3& d, const Vec3& e)
 {
-  const Vec3 ad = d - a, ae = e - a;
-  const double sd = n.dot(ad), se = n.dot(ae);
-  const double nn = n.norm();
-  const double td = 1e-6 * nn * ad.norm(), te = 1e-6 * nn * ae.norm();
-  return (sd > td && se > te) || (sd < -td && se < -te);
+  return oneSideImpl(a, n, d, e);
 }
 
 bool LocalChangeVeto::separatedByAxes(const ChangedTriangle& a, const LocalChangeScratch::Candidate& b, double gap)
 {
-  if (separated(a.Pts, b.Pts, b.C - a.C, gap) || separated(a.Pts, b.Pts, a.N, gap))
-    return true;
-  const Vec3 nb = (b.Pts[1] - b.Pts[0]).cross(b.Pts[2] - b.Pts[0]);
-  if (separated(a.Pts, b.Pts, nb, gap))
-    return true;
-  for (int k = 0; k < 3; ++k)
-    if (separated(a.Pts, b.Pts, a.N.cross(a.Pts[(k + 1) % 3] - a.Pts[k]), gap) ||
-      separated(a.Pts, b.Pts, nb.cross(b.Pts[(k + 1) % 3] - b.Pts[k]), gap))
-      return true;
-  return false;
+  return separatedByAxesImpl(a, b, gap);
 }
 
 } // namespace sdfcage

@@ -16,6 +16,7 @@
 
 #include <cmath>
 #include <limits>
+#include <type_traits>
 #include <vector>
 
 namespace sdfcage
@@ -108,7 +109,7 @@ class VertexDistanceRef
 {
 public:
   VertexDistanceRef() = default;
-  template <typename F>
+  template <typename F, typename = std::enable_if_t<!std::is_same<std::decay_t<F>, VertexDistanceRef>::value>>
   VertexDistanceRef(F& f) // NOLINT: implicit on purpose
     : Object(&f)
     , Call([](void* o, int v) { return (*static_cast<F*>(o))(v); })
@@ -147,7 +148,7 @@ struct LocalChangeScratch
     int Ids[3];
     Vec3 Pts[3];
     Vec3 Lo, Hi, C;
-    double R;
+    double R; // < 0 until the bounding sphere (C, R) is computed
   };
   std::vector<Candidate> Candidates;
   TriangleStamps Seen;
