@@ -1,11 +1,14 @@
 #include "Optimization/Optimization.h"
 
-#include "Spatial/Geometry.h"
-#include "Mesh/Normalization.h"
 #include "Common/Progress.h"
-#include "Quality/Verification.h"
-#include "Spatial/TriangleTree.h"
+#include "Mesh/EdgeKey.h"
+#include "Mesh/Normalization.h"
 #include "Mesh/Validation.h"
+#include "Quality/LocalChangeVeto.h"
+#include "Quality/Verification.h"
+#include "Spatial/CageGrid.h"
+#include "Spatial/Geometry.h"
+#include "Spatial/TriangleTree.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
@@ -30,9 +33,6 @@ namespace
 {
 
 constexpr double Inf = std::numeric_limits<double>::infinity();
-// Neighbouring cage triangles whose dihedral angle closes below ~18 degrees count as folded (the
-// simplifier's threshold).
-constexpr double FoldCosine = -0.95;
 // Bisection steps of the continuous collision detection when a whole move is not clear.
 constexpr int BisectionSteps = 10;
 // Sufficient-decrease fraction of the line search (Armijo condition).
@@ -65,13 +65,6 @@ double barrierDerivative(double g, double dh)
   if (g >= dh || !(g > 0.0))
     return 0.0;
   return -2.0 * (g - dh) * std::log(g / dh) - (g - dh) * (g - dh) / g;
-}
-
-double triangleQuality(const Vec3& a, const Vec3& b, const Vec3& c)
-{
-  const double area2 = (b - a).cross(c - a).norm();
-  const double s = (b - a).squaredNorm() + (c - b).squaredNorm() + (a - c).squaredNorm();
-  return s > 0 ? 2.0 * std::sqrt(3.0) * area2 / s : 0.0;
 }
 
 /// MIPS with an equilateral reference, sum(l^2) / (2 sqrt(3) A), and its gradient with respect
@@ -146,14 +139,26 @@ Sphere boundingSphere(const Vec3& a, const Vec3& b, const Vec3& c)
   return { m, std::sqrt(std::max({ (a - m).squaredNorm(), (b - m).squaredNorm(), (c - m).squaredNorm() })) };
 }
 
-std::uint64_t edgeKey(int a, int b)
+/// The veto's rules for the optimizer's changes (a vertex move, an edge flip): no triangle worse
+/// than min(the quality floor, what it replaces), no flip, and pairs that were already closer than
+/// the self clearance may keep half their distance (moves only: a flip makes new pairs).
+LocalChangePolicy changePolicy(const OptimizeOptions& o, double clearance, double selfClearance, bool move)
 {
-  if (a > b)
-    std::swap(a, b);
-  return (static_cast<std::uint64_t>(a) << 32) | static_cast<std::uint32_t>(b);
+  LocalChangePolicy p;
+  p.MinimumTriangleQuality = o.MinimumTriangleQuality;
+  p.KeepQualityBefore = true;
+  p.MinimumNormalCosine = 0.0;
+  // FoldCosine: the default, the simplifier's
+  p.Clearance = clearance;
+  // a move's input clearance is established by the collision-free sweep (sweepClear)
+  p.Input = move ? LocalChangePolicy::InputTest::None : LocalChangePolicy::InputTest::Exact;
+  p.SelfClearance = selfClearance;
+  p.RelaxCloserPairs = move;
+  return p;
 }
 
-/// The optimizer's working state: the cage with vertex-triangle adjacency and cached boxes.
+/// The optimizer's working state: the cage with vertex-triangle adjacency, cached boxes and a
+/// grid of them.
 class Optimizer
 {
 public:
@@ -165,6 +170,8 @@ public:
     , Delta(clearance)
     , SelfDelta(selfClearance)
     , Prog(progress)
+    , MoveVeto(changePolicy(o, clearance, selfClearance, true), tree, CageView{ &P, &T, nullptr, &Lo, &Hi, &Grid })
+    , FlipVeto(changePolicy(o, clearance, selfClearance, false), tree, CageView{ &P, &T, nullptr, &Lo, &Hi, &Grid })
   {
     P = cage.Points;
     T = cage.Triangles;
@@ -183,8 +190,19 @@ public:
         seen[component[f]] = 1;
         Representatives.push_back(input.Points[input.Triangles[f][0]]);
       }
+    double area = 0.0;
     for (std::size_t f = 0; f < T.size(); ++f)
-      updateBox(static_cast<int>(f));
+    {
+      const Triangle& t = T[f];
+      Lo[f] = P[t[0]].cwiseMin(P[t[1]]).cwiseMin(P[t[2]]);
+      Hi[f] = P[t[0]].cwiseMax(P[t[1]]).cwiseMax(P[t[2]]);
+      area += 0.5 * (P[t[1]] - P[t[0]]).cross(P[t[2]] - P[t[0]]).norm();
+    }
+    // cells of about two mean edges (the edge of an equilateral triangle of the mean area)
+    const double meanEdge = std::sqrt(4.0 * area / std::max<std::size_t>(1, T.size()) / std::sqrt(3.0));
+    Grid.reset(std::max(2.0 * meanEdge, 1e-6));
+    for (std::size_t f = 0; f < T.size(); ++f)
+      Grid.insert(static_cast<int>(f), Lo[f], Hi[f]);
   }
 
   TriangleMesh mesh() const
@@ -405,10 +423,18 @@ public:
       return std::sqrt(triangleTriangleDistance2(rp, q));
     };
     std::vector<double> d0(nr);
-    for (std::size_t f = 0; f < T.size(); ++f)
+    // the cage triangles whose boxes meet [lo, hi], in index order
+    Work& w = work();
+    std::vector<int>& nearby = w.Nearby;
+    nearby.clear();
+    w.Change.Seen.begin(T.size());
+    Grid.query(lo, hi, [&](int f) {
+      if (w.Change.Seen.insert(f) && !((Lo[f].array() > hi.array()).any() || (Hi[f].array() < lo.array()).any()))
+        nearby.push_back(f);
+    });
+    std::sort(nearby.begin(), nearby.end());
+    for (int f : nearby)
     {
-      if ((Lo[f].array() > hi.array()).any() || (Hi[f].array() < lo.array()).any())
-        continue;
       const Triangle& t = T[f];
       if (t[0] == v || t[1] == v || t[2] == v)
         continue;
@@ -519,7 +545,7 @@ public:
   /// The distance a pair of vertex-disjoint cage triangles must keep: the self clearance, or half
   /// their distance before the move when they were already closer (a given cage, or the dense
   /// envelope's leftovers, may have such pairs; they may move, but never touch).
-  double relaxed(double before) const { return before >= SelfDelta ? SelfDelta : 0.5 * before; }
+  double relaxed(double before) const { return MoveVeto.policy().relaxed(before); }
 
   /// Is the straight move of v from P0 to q collision-free? The ring triangle (v, a, b) sweeps
   /// exactly the tetrahedron conv(P0, q, a, b) (a point of it is (P0 + s (q - P0)) weighted with
@@ -711,82 +737,37 @@ public:
 
   // ---- static acceptance test ---------------------------------------------------------------
 
-  /// The ring of v at p: no needle or flip, clearance to the input (exact distances through the
-  /// tree), no conflict with any other cage triangle (the simplifier's test).
-  /// `inputChecked`: the input clearance of the ring at p was just established by sweepClear()
-  /// (its tetrahedra have the ring at p as a face, tested with the same anyCloserThan).
-  bool ringAcceptable(const Local& L, const Vec3& p, bool inputChecked) const
+  /// The veto (Quality/LocalChangeVeto.h) on the ring of v moved to p: no needle or flip, no
+  /// fold, no conflict with any other cage triangle. The input clearance of the ring at p is not
+  /// tested again: sweepClear() established it (its tetrahedra have the ring at p as a face,
+  /// tested with the same anyCloserThan). Sets the work's LastVeto.
+  bool ringAcceptable(const Local& L, const Vec3& p) const
   {
     Work& w = work();
-    w.LastVeto = Veto::Shape;
-    const int n = static_cast<int>(L.RingIds.size());
-    std::vector<std::array<Vec3, 3>> pts(n);
-    for (int i = 0; i < n; ++i)
+    LocalChangeScratch& s = w.Change;
+    const std::size_t n = L.RingIds.size();
+    s.Tris.resize(n);
+    for (std::size_t i = 0; i < n; ++i)
     {
       const auto& ids = L.RingIds[i];
-      pts[i] = { p, P[ids[1]], P[ids[2]] };
-      const Vec3 before = (P[ids[1]] - L.P0).cross(P[ids[2]] - L.P0);
-      const Vec3 after = (pts[i][1] - p).cross(pts[i][2] - p);
-      if (!(after.dot(before) > 0))
-        return false;
-      const double q0 = triangleQuality(L.P0, P[ids[1]], P[ids[2]]);
-      if (triangleQuality(p, P[ids[1]], P[ids[2]]) < std::min(Opt.MinimumTriangleQuality, q0))
-        return false;
-      if (!inputChecked && Tree.anyCloserThan(pts[i].data(), Delta))
-        return false;
+      ChangedTriangle& t = s.Tris[i];
+      for (int k = 0; k < 3; ++k)
+        t.Ids[k] = ids[k];
+      t.Pts[0] = p;
+      t.Pts[1] = P[ids[1]];
+      t.Pts[2] = P[ids[2]];
+      t.Before[0] = L.P0;
+      t.Before[1] = P[ids[1]];
+      t.Before[2] = P[ids[2]];
+      t.Reference = (P[ids[1]] - L.P0).cross(P[ids[2]] - L.P0);
+      t.QualityBefore = triangleQuality(L.P0, P[ids[1]], P[ids[2]]);
     }
-    w.LastVeto = Veto::Self;
-    for (int i = 0; i < n; ++i)
-      for (int j = i + 1; j < n; ++j)
-        if (trianglesConflict(L.RingIds[i].data(), pts[i].data(), L.RingIds[j].data(), pts[j].data(), SelfDelta, FoldCosine))
-          return false;
-    for (int i = 0; i < n; ++i)
-    {
-      const Vec3 lo = pts[i][0].cwiseMin(pts[i][1]).cwiseMin(pts[i][2]) - Vec3::Constant(SelfDelta);
-      const Vec3 hi = pts[i][0].cwiseMax(pts[i][1]).cwiseMax(pts[i][2]) + Vec3::Constant(SelfDelta);
-      const Vec3 before[3] = { L.P0, P[L.RingIds[i][1]], P[L.RingIds[i][2]] };
-      if (!othersClear(L.RingIds[i].data(), pts[i].data(), lo, hi, L.Ring.data(), L.Ring.size(), before))
-        return false;
-    }
-    return true;
-  }
-
-  /// No cage triangle other than `skip` conflicts with the triangle (ids, pts) of box [lo, hi].
-  /// `before` (optional): the same triangle before the change, for the relaxed margin of pairs
-  /// that were already closer than the self clearance.
-  bool othersClear(const int ids[3], const Vec3 pts[3], const Vec3& lo, const Vec3& hi, const int* skip,
-    std::size_t skipCount, const Vec3* before = nullptr) const
-  {
-    for (std::size_t f = 0; f < T.size(); ++f)
-    {
-      if ((Lo[f].array() > hi.array()).any() || (Hi[f].array() < lo.array()).any())
-        continue;
-      if (std::find(skip, skip + skipCount, static_cast<int>(f)) != skip + skipCount)
-        continue;
-      const Triangle& t = T[f];
-      const int tid[3] = { t[0], t[1], t[2] };
-      const Vec3 tp[3] = { P[t[0]], P[t[1]], P[t[2]] };
-      bool disjoint = true;
-      for (int a : tid)
-        disjoint = disjoint && a != ids[0] && a != ids[1] && a != ids[2];
-      if (disjoint)
-      {
-        // disjoint triangles whose bounding spheres are farther apart than SelfDelta cannot conflict
-        const Sphere s1 = boundingSphere(pts[0], pts[1], pts[2]), s2 = boundingSphere(tp[0], tp[1], tp[2]);
-        if ((s1.C - s2.C).norm() - s1.R - s2.R >= SelfDelta)
-          continue;
-      }
-      if (trianglesConflict(ids, pts, tid, tp, SelfDelta, FoldCosine))
-      {
-        if (!disjoint || !before)
-          return false;
-        const double d0 = std::sqrt(triangleTriangleDistance2(before, tp));
-        const double d2 = triangleTriangleDistance2(pts, tp);
-        if (d0 >= SelfDelta || d2 == 0.0 || d2 < relaxed(d0) * relaxed(d0))
-          return false;
-      }
-    }
-    return true;
+    s.Replaced.begin(T.size());
+    for (int f : L.Ring)
+      s.Replaced.insert(f);
+    const LocalChangeVerdict v = MoveVeto.check(s);
+    w.LastVeto = v == LocalChangeVerdict::Shape ? Veto::Shape : Veto::Self;
+    return v == LocalChangeVerdict::Accepted;
   }
 
   // ---- one descent step at v: 1 moved, 0 converged (no descent direction), -1 no acceptable step
@@ -832,7 +813,7 @@ public:
           continue;
         }
       }
-      if (!ringAcceptable(L, p, true))
+      if (!ringAcceptable(L, p))
       {
         worst = w.LastVeto;
         continue;
@@ -863,6 +844,8 @@ public:
     std::vector<int> Points;
     Veto LastVeto = Veto::Shape;
     long long Counts[4] = { 0, 0, 0, 0 };
+    LocalChangeScratch Change; ///< the veto's scratch
+    std::vector<int> Nearby;   ///< gather()'s cage triangles
   };
   Work& work() const { return Works.local(); }
   /// The veto counts summed over the threads.
@@ -907,20 +890,29 @@ public:
     const double after = triangleEnergy(P[c], P[a], P[d], Tree, Opt) + triangleEnergy(P[d], P[b], P[c], Tree, Opt);
     if (!(after < before - 1e-12 * std::abs(before)))
       return 0;
-    const double qmin = std::min({ Opt.MinimumTriangleQuality, triangleQuality(P[a], P[b], P[c]),
-      triangleQuality(P[b], P[a], P[d]) });
+    // the veto: both new triangles at least min(the floor, the worse old one), not flipped
+    // against the old pair's mean normal, clear of the input and of the rest of the cage
+    const double qBefore = std::min(triangleQuality(P[a], P[b], P[c]), triangleQuality(P[b], P[a], P[d]));
     const Vec3 nOld = (P[b] - P[a]).cross(P[c] - P[a]).normalized() + (P[a] - P[b]).cross(P[d] - P[b]).normalized();
-    const int ids1[3] = { c, a, d }, ids2[3] = { d, b, c };
-    const Vec3 p1[3] = { P[c], P[a], P[d] }, p2[3] = { P[d], P[b], P[c] };
-    for (const Vec3* p : { p1, p2 })
+    LocalChangeScratch& s = work().Change;
+    s.Tris.resize(2);
+    for (int i = 0; i < 2; ++i)
     {
-      if (triangleQuality(p[0], p[1], p[2]) < qmin)
-        return -1;
-      if (!((p[1] - p[0]).cross(p[2] - p[0]).dot(nOld) > 0))
-        return -1;
-      if (Tree.anyCloserThan(p, Delta))
-        return -1;
+      const Triangle& n = i == 0 ? n1 : n2;
+      ChangedTriangle& t = s.Tris[i];
+      for (int k = 0; k < 3; ++k)
+      {
+        t.Ids[k] = n[k];
+        t.Pts[k] = P[n[k]];
+      }
+      t.Reference = nOld;
+      t.QualityBefore = qBefore;
     }
+    s.Replaced.begin(T.size());
+    s.Replaced.insert(f1);
+    s.Replaced.insert(f2);
+    if (FlipVeto.check(s) != LocalChangeVerdict::Accepted)
+      return -1;
     // the flip sweeps the tetrahedron (a, b, c, d): an input component wholly inside it (its
     // representative inside; none comes near the four faces) would end up outside the cage
     {
@@ -939,18 +931,6 @@ public:
           return -1;
       }
     }
-    if (trianglesConflict(ids1, p1, ids2, p2, SelfDelta, FoldCosine))
-      return -1;
-    const int skip[2] = { f1, f2 };
-    for (int i = 0; i < 2; ++i)
-    {
-      const int* ids = i == 0 ? ids1 : ids2;
-      const Vec3* p = i == 0 ? p1 : p2;
-      const Vec3 lo = p[0].cwiseMin(p[1]).cwiseMin(p[2]) - Vec3::Constant(SelfDelta);
-      const Vec3 hi = p[0].cwiseMax(p[1]).cwiseMax(p[2]) + Vec3::Constant(SelfDelta);
-      if (!othersClear(ids, p, lo, hi, skip, 2))
-        return -1;
-    }
     T[f1] = n1;
     T[f2] = n2;
     auto drop = [&](int v, int f) {
@@ -966,11 +946,14 @@ public:
     return 1;
   }
 
+  /// Refiles triangle f (moved or flipped) in the grid with its new box.
   void updateBox(int f)
   {
     const Triangle& t = T[f];
+    Grid.remove(f, Lo[f], Hi[f]);
     Lo[f] = P[t[0]].cwiseMin(P[t[1]]).cwiseMin(P[t[2]]);
     Hi[f] = P[t[0]].cwiseMax(P[t[1]]).cwiseMax(P[t[2]]);
+    Grid.insert(f, Lo[f], Hi[f]);
   }
 
 private:
@@ -983,9 +966,11 @@ private:
   std::vector<Vec3> P;
   std::vector<Triangle> T;
   std::vector<std::vector<int>> VT;
-  std::vector<Vec3> Lo, Hi;
+  std::vector<Vec3> Lo, Hi; ///< triangle boxes, as filed in the grid
+  CageGrid Grid;            ///< updated between relocation batches and after each flip
   std::vector<Vec3> Representatives; ///< one input point per input component
   mutable tbb::enumerable_thread_specific<Work> Works;
+  LocalChangeVeto MoveVeto, FlipVeto; ///< read P, T, Lo, Hi and Grid
 };
 
 } // namespace

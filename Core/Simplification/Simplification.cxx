@@ -1,7 +1,9 @@
 #include "Simplification/Simplification.h"
 
-#include "Spatial/Geometry.h"
 #include "Common/Progress.h"
+#include "Mesh/EdgeKey.h"
+#include "Quality/LocalChangeVeto.h"
+#include "Spatial/CageGrid.h"
 #include "Spatial/TriangleTree.h"
 
 #include <algorithm>
@@ -10,7 +12,6 @@
 #include <cstdint>
 #include <limits>
 #include <queue>
-#include <unordered_map>
 #include <unordered_set>
 
 #include <tbb/enumerable_thread_specific.h>
@@ -75,63 +76,6 @@ struct Quadric
   }
 };
 
-// ---- dynamic uniform hash grid over the cage's triangle boxes ---------------------------------
-class CageGrid
-{
-public:
-  void reset(double cellSize)
-  {
-    Cell = cellSize;
-    Cells.clear();
-  }
-  double cellSize() const { return Cell; }
-  template <typename F>
-  void forCells(const Vec3& lo, const Vec3& hi, F&& f) const
-  {
-    const std::int64_t i0 = key1(lo.x()), i1 = key1(hi.x());
-    const std::int64_t j0 = key1(lo.y()), j1 = key1(hi.y());
-    const std::int64_t k0 = key1(lo.z()), k1 = key1(hi.z());
-    for (std::int64_t k = k0; k <= k1; ++k)
-      for (std::int64_t j = j0; j <= j1; ++j)
-        for (std::int64_t i = i0; i <= i1; ++i)
-          f(((k & 0x1FFFFF) << 42) | ((j & 0x1FFFFF) << 21) | (i & 0x1FFFFF));
-  }
-  void insert(int t, const Vec3& lo, const Vec3& hi)
-  {
-    forCells(lo, hi, [&](std::int64_t key) { Cells[key].push_back(t); });
-  }
-  void remove(int t, const Vec3& lo, const Vec3& hi)
-  {
-    forCells(lo, hi, [&](std::int64_t key) {
-      auto it = Cells.find(key);
-      if (it == Cells.end())
-        return;
-      auto& v = it->second;
-      auto pos = std::find(v.begin(), v.end(), t);
-      if (pos != v.end())
-      {
-        *pos = v.back();
-        v.pop_back();
-      }
-    });
-  }
-  template <typename F>
-  void query(const Vec3& lo, const Vec3& hi, F&& f) const
-  {
-    forCells(lo, hi, [&](std::int64_t key) {
-      auto it = Cells.find(key);
-      if (it != Cells.end())
-        for (int t : it->second)
-          f(t);
-    });
-  }
-
-private:
-  std::int64_t key1(double x) const { return static_cast<std::int64_t>(std::floor(x / Cell)); }
-  double Cell = 1.0;
-  std::unordered_map<std::int64_t, std::vector<int>> Cells;
-};
-
 struct Entry
 {
   double Cost;
@@ -149,32 +93,6 @@ struct Entry
   }
 };
 
-enum class Verdict
-{
-  Ok,
-  Topology,
-  Shape,
-  Input,
-  Self
-};
-
-std::uint64_t edgeKey(int a, int b)
-{
-  if (a > b)
-    std::swap(a, b);
-  return (static_cast<std::uint64_t>(a) << 32) | static_cast<std::uint32_t>(b);
-}
-
-double triangleQuality(const Vec3& a, const Vec3& b, const Vec3& c)
-{
-  const double area2 = (b - a).cross(c - a).norm(); // twice the area
-  const double s = (b - a).squaredNorm() + (c - b).squaredNorm() + (a - c).squaredNorm();
-  return s > 0 ? 2.0 * std::sqrt(3.0) * area2 / s : 0.0;
-}
-
-// Neighbouring cage triangles whose dihedral angle closes below ~18 degrees count as folded.
-constexpr double FoldCosine = -0.95;
-
 // Candidate collapses evaluated together. The batch is formed, evaluated and applied the same way
 // whatever the number of threads, so the cage does not depend on it.
 constexpr int BatchSize = 32;
@@ -186,37 +104,11 @@ struct Sample
   Vec3 Dir = Vec3::Zero();
 };
 
-struct NewTri
-{
-  int Ids[3];
-  Vec3 Pts[3];
-  Vec3 N;
-  Vec3 C;   // centroid
-  double R; // bounding radius about C
-};
-
-struct Candidate
-{
-  int F;
-  int Ids[3];
-  Vec3 Pts[3];
-  Vec3 Lo, Hi, C;
-  double R;
-};
-
-// Per-thread scratch of the evaluation (per-triangle stamps and reusable buffers).
+// Per-thread scratch of the evaluation.
 struct Scratch
 {
-  explicit Scratch(std::size_t triangles = 0)
-    : Mark(triangles, 0)
-    , Seen(triangles, 0)
-  {
-  }
-  std::vector<unsigned> Mark, Seen; // triangle stamps: of the collapse; already a candidate
-  unsigned MarkId = 0, QueryId = 0;
   std::vector<int> N0, N1;
-  std::vector<NewTri> NewTris;
-  std::vector<Candidate> Candidates;
+  LocalChangeScratch Veto; // the new triangles of the collapse, the triangles it replaces
   std::vector<std::pair<int, Sample>> SampleCache;
 };
 
@@ -250,7 +142,7 @@ public:
     , Opt(o)
     , Original(o)
     , Prog(p)
-    , Scratches(Scratch(mesh.Triangles.size()))
+    , Veto(policy(o), input, CageView{ &P, &T, &TAlive, nullptr, nullptr, &Grid })
   {
     P = mesh.Points;
     T = mesh.Triangles;
@@ -486,8 +378,8 @@ public:
     if (!ev.Gathered)
       return;
     Vec3 pos = ev.E.Pos;
-    const Verdict v = check(pos, ev);
-    if (v != Verdict::Ok)
+    const LocalChangeVerdict v = check(pos, ev);
+    if (v != LocalChangeVerdict::Accepted)
     {
       countReject(v, ev);
       if (!place(pos, v, ev))
@@ -525,19 +417,20 @@ public:
   {
     Opt.MinimumNormalCosine = std::min(Opt.MinimumNormalCosine, 0.0);
     Opt.MinimumTriangleQuality = 0.5 * Original.MinimumTriangleQuality;
+    Veto.setPolicy(policy(Opt));
   }
 
   // The placement `pos` of the gathered collapse failed with verdict `first`. Looks for a
   // feasible one: the midpoint and the endpoints; the Psi descent from the placement (and, in the
   // thorough passes, from the other starts); in the thorough passes, an outward walk along the
   // one-ring's normal. Returns the cheapest found first in that order.
-  bool place(Vec3& pos, Verdict first, Eval& ev) const
+  bool place(Vec3& pos, LocalChangeVerdict first, Eval& ev) const
   {
     // the ordinary pass keeps to the Psi descent from the placement when the input is too
     // close: trying alternatives on every rejection of a dense envelope costs more than it gains
     if (Pass == 0)
     {
-      if (first != Verdict::Input)
+      if (first != LocalChangeVerdict::InputClearance)
         return false;
       Vec3 p = pos;
       if (!relocate(p, ev))
@@ -554,7 +447,7 @@ public:
       cost[i] = costAt(c0, c1, starts[i]);
     std::sort(order, order + 3, [&](int a, int b) { return cost[a] < cost[b] || (cost[a] == cost[b] && a < b); });
     for (int i : order)
-      if (check(starts[i], ev) == Verdict::Ok && withinReach(starts[i]))
+      if (check(starts[i], ev) == LocalChangeVerdict::Accepted && withinReach(starts[i]))
       {
         pos = starts[i];
         return true;
@@ -585,7 +478,7 @@ public:
       for (double t = Opt.Clearance; t <= reach; t *= 2)
       {
         const Vec3 p = starts[i] + t * n;
-        if (check(p, ev) == Verdict::Ok && withinReach(p))
+        if (check(p, ev) == LocalChangeVerdict::Accepted && withinReach(p))
         {
           pos = p;
           return true;
@@ -740,16 +633,11 @@ private:
     // keep at least a tetrahedron per component
     if (s.N0.size() + s.N1.size() <= 6 && AliveVertices <= 4)
       return false;
-    ++s.MarkId;
-    if (s.MarkId == 0)
-    {
-      std::fill(s.Mark.begin(), s.Mark.end(), 0);
-      s.MarkId = 1;
-    }
+    s.Veto.Replaced.begin(T.size());
     for (int f : ev.Removed)
-      s.Mark[f] = s.MarkId;
+      s.Veto.Replaced.insert(f);
     for (int f : ev.Changed)
-      s.Mark[f] = s.MarkId;
+      s.Veto.Replaced.insert(f);
     return true;
   }
 
@@ -766,164 +654,47 @@ private:
     }
   }
 
-  Verdict check(const Vec3& p, Eval& ev) const
+  // The veto (Quality/LocalChangeVeto.h) on the collapse gathered in ev with v0 placed at p:
+  // shape, fold, input clearance (bounded by the cached vertex distances), self-intersection.
+  LocalChangeVerdict check(const Vec3& p, Eval& ev) const
   {
-    Scratch& s = *ev.S;
-    ev.LastCheckExact = false;
-    const double delta = Opt.Clearance;
-    const double selfDelta = Opt.selfClearance();
-    auto& newTris = s.NewTris;
-    newTris.resize(ev.Changed.size());
-    // shape first (cheap): no needles, no flips
+    LocalChangeScratch& s = ev.S->Veto;
+    s.Tris.resize(ev.Changed.size());
     for (std::size_t i = 0; i < ev.Changed.size(); ++i)
     {
-      auto& nt = newTris[i];
+      ChangedTriangle& nt = s.Tris[i];
       newTriangle(ev, ev.Changed[i], p, nt.Ids, nt.Pts);
-      if (triangleQuality(nt.Pts[0], nt.Pts[1], nt.Pts[2]) < Opt.MinimumTriangleQuality)
-        return Verdict::Shape;
       const Triangle& old = T[ev.Changed[i]];
-      const Vec3 no = (P[old[1]] - P[old[0]]).cross(P[old[2]] - P[old[0]]);
-      nt.N = (nt.Pts[1] - nt.Pts[0]).cross(nt.Pts[2] - nt.Pts[0]);
-      nt.C = (nt.Pts[0] + nt.Pts[1] + nt.Pts[2]) / 3.0;
-      nt.R = std::max({ (nt.Pts[0] - nt.C).norm(), (nt.Pts[1] - nt.C).norm(), (nt.Pts[2] - nt.C).norm() });
-      if (no.dot(nt.N) <= Opt.MinimumNormalCosine * no.norm() * nt.N.norm())
-        return Verdict::Shape;
+      nt.Reference = (P[old[1]] - P[old[0]]).cross(P[old[2]] - P[old[0]]);
     }
-    // among the new triangles (they all share v0): no folds, no crossings
-    for (std::size_t i = 0; i < newTris.size() && Opt.EnforceNoSelfIntersection; ++i)
-      for (std::size_t j = i + 1; j < newTris.size(); ++j)
-        if (trianglesConflict(newTris[i].Ids, newTris[i].Pts, newTris[j].Ids, newTris[j].Pts, selfDelta, FoldCosine))
-          return Verdict::Self;
-    // the input: clearance delta. Early-out (the distance to the input is 1-Lipschitz): every new
-    // triangle lies within `reach` of p (its farthest point from p is a corner), so if no input
-    // lies within delta + reach of p, all of them are clear. Otherwise exact triangle-triangle
-    // distances through the tree.
-    if (Opt.EnforceClearance)
+    const MovedVertex moved{ ev.C0, p };
+    auto distance = [&](int v) { return vertexDistance(v, ev); };
+    LocalChangeFindings found;
+    const LocalChangeVerdict v = Veto.check(s, &moved, distance, &found);
+    ev.LastCheckExact = found.MovedDistanceExact;
+    if (found.MovedDistanceExact)
     {
-      // Early-outs from the distance being 1-Lipschitz. A point x of a triangle with barycentric
-      // weights l_k satisfies sum_k l_k |x - v_k|^2 = sum_k l_k |v_k - o|^2 - |x - o|^2 for any o,
-      // so with o the centroid, the average of |x - v_k| is at most R (the corners' largest
-      // distance from the centroid) and d(x) >= sum_k l_k (D(v_k) - |x - v_k|) >= min_k D(v_k) - R.
-      // D(p) comes from one query bounded by delta + max R (beyond it, that bound is all we need);
-      // the other corners' distances are cached per vertex. Triangles the bound does not clear
-      // get the exact triangle-input distance through the tree.
-      double maxR = 0;
-      for (const auto& nt : newTris)
-        maxR = std::max(maxR, nt.R);
-      const double limit = delta + maxR;
-      Vec3 c;
-      int tri;
-      double dp;
-      if (!Input.closestPoint(p, limit, c, tri, dp))
-        dp = limit;
+      ev.LastCheckPos = p;
+      ev.LastCheckDistance = found.MovedDistance;
+    }
+    if (found.Read)
+    {
+      if (ev.HasRead)
+      {
+        ev.ReadLo = ev.ReadLo.cwiseMin(found.ReadLo);
+        ev.ReadHi = ev.ReadHi.cwiseMax(found.ReadHi);
+      }
       else
       {
-        ev.LastCheckPos = p;
-        ev.LastCheckDistance = dp;
-        ev.LastCheckExact = true;
-      }
-      for (const auto& nt : newTris)
-      {
-        double lo = dp;
-        for (int k = 0; k < 3 && lo - nt.R > delta * (1 + 1e-9); ++k)
-          if (nt.Ids[k] != ev.C0)
-            lo = std::min(lo, vertexDistance(nt.Ids[k], ev));
-        if (lo - nt.R > delta * (1 + 1e-9))
-          continue;
-        if (Input.anyCloserThan(nt.Pts, delta))
-          return Verdict::Input;
-      }
-      if (sweepsProbe(p, ev))
-        return Verdict::Input;
-    }
-    if (!Opt.EnforceNoSelfIntersection)
-      return Verdict::Ok;
-    // the rest of the cage: one grid query for the whole new one-ring, then per pair a box test,
-    // a bounding-sphere test for disjoint triangles, and the exact conflict test
-    Vec3 ringLo = Vec3::Constant(std::numeric_limits<double>::infinity()), ringHi = -ringLo;
-    for (const auto& nt : newTris)
-      for (const Vec3& q : nt.Pts)
-      {
-        ringLo = ringLo.cwiseMin(q);
-        ringHi = ringHi.cwiseMax(q);
-      }
-    ringLo -= Vec3::Constant(selfDelta);
-    ringHi += Vec3::Constant(selfDelta);
-    if (ev.HasRead)
-    {
-      ev.ReadLo = ev.ReadLo.cwiseMin(ringLo);
-      ev.ReadHi = ev.ReadHi.cwiseMax(ringHi);
-    }
-    else
-    {
-      ev.ReadLo = ringLo;
-      ev.ReadHi = ringHi;
-      ev.HasRead = true;
-    }
-    auto& candidates = s.Candidates;
-    candidates.clear();
-    ++s.QueryId;
-    if (s.QueryId == 0)
-    {
-      std::fill(s.Seen.begin(), s.Seen.end(), 0);
-      s.QueryId = 1;
-    }
-    Grid.query(ringLo, ringHi, [&](int f) {
-      if (!TAlive[f] || s.Mark[f] == s.MarkId || s.Seen[f] == s.QueryId)
-        return;
-      s.Seen[f] = s.QueryId;
-      Candidate c;
-      c.F = f;
-      for (int k = 0; k < 3; ++k)
-      {
-        c.Ids[k] = T[f][k];
-        c.Pts[k] = P[T[f][k]];
-      }
-      c.Lo = c.Pts[0].cwiseMin(c.Pts[1]).cwiseMin(c.Pts[2]);
-      c.Hi = c.Pts[0].cwiseMax(c.Pts[1]).cwiseMax(c.Pts[2]);
-      if ((c.Lo.array() > ringHi.array()).any() || (c.Hi.array() < ringLo.array()).any())
-        return;
-      c.C = (c.Pts[0] + c.Pts[1] + c.Pts[2]) / 3.0;
-      c.R = std::max({ (c.Pts[0] - c.C).norm(), (c.Pts[1] - c.C).norm(), (c.Pts[2] - c.C).norm() });
-      candidates.push_back(c);
-    });
-    for (const auto& nt : newTris)
-    {
-      const Vec3 lo = nt.Pts[0].cwiseMin(nt.Pts[1]).cwiseMin(nt.Pts[2]) - Vec3::Constant(selfDelta);
-      const Vec3 hi = nt.Pts[0].cwiseMax(nt.Pts[1]).cwiseMax(nt.Pts[2]) + Vec3::Constant(selfDelta);
-      for (const Candidate& c : candidates)
-      {
-        if ((c.Lo.array() > hi.array()).any() || (c.Hi.array() < lo.array()).any())
-          continue;
-        int shared = 0, ka = -1, kb = -1;
-        for (int i = 0; i < 3; ++i)
-          for (int j = 0; j < 3; ++j)
-            if (nt.Ids[i] == c.Ids[j])
-            {
-              ++shared;
-              ka = i;
-              kb = j;
-            }
-        const bool disjoint = shared == 0;
-        // sharing one vertex: they cannot meet elsewhere when the other two corners of one lie
-        // strictly on one side of the other's plane (by an angle far above rounding, so
-        // meetBeyondSharedVertex's nearly-coplanar case cannot apply)
-        if (shared == 1 &&
-          (oneSide(nt.Pts[ka], nt.N, c.Pts[(kb + 1) % 3], c.Pts[(kb + 2) % 3]) ||
-            oneSide(c.Pts[kb], (c.Pts[1] - c.Pts[0]).cross(c.Pts[2] - c.Pts[0]), nt.Pts[(ka + 1) % 3], nt.Pts[(ka + 2) % 3])))
-          continue;
-        // disjoint triangles whose bounding spheres are farther apart than selfDelta cannot conflict
-        if (disjoint && (c.C - nt.C).norm() - c.R - nt.R >= selfDelta)
-          continue;
-        // nor those a separating axis keeps selfDelta apart: the centroids' line, the normals,
-        // and (for the nearly coplanar neighbours of a flat region) the in-plane edge normals
-        if (disjoint && separatedByAxes(nt, c, selfDelta))
-          continue;
-        if (trianglesConflict(nt.Ids, nt.Pts, c.Ids, c.Pts, selfDelta, FoldCosine))
-          return Verdict::Self;
+        ev.ReadLo = found.ReadLo;
+        ev.ReadHi = found.ReadHi;
+        ev.HasRead = true;
       }
     }
-    return Verdict::Ok;
+    // and no input component swept out of the cage (see sweepsProbe)
+    if (v == LocalChangeVerdict::Accepted && Opt.EnforceClearance && sweepsProbe(p, ev))
+      return LocalChangeVerdict::InputClearance;
+    return v;
   }
 
   // Would the collapse sweep an input component out of the cage? The old one-ring (the changed
@@ -977,42 +748,16 @@ private:
     return false;
   }
 
-  // Do the projections of a and b on axis u leave a gap of at least `gap` (either order)? The
-  // distance of two convex sets is at least the gap of their projections on any axis.
-  static bool separated(const Vec3 a[3], const Vec3 b[3], const Vec3& u, double gap)
+  static LocalChangePolicy policy(const SimplifyOptions& o)
   {
-    const double n = u.norm();
-    if (!(n > 0))
-      return false;
-    const double a0 = u.dot(a[0]), a1 = u.dot(a[1]), a2 = u.dot(a[2]);
-    const double b0 = u.dot(b[0]), b1 = u.dot(b[1]), b2 = u.dot(b[2]);
-    const double g = gap * n * (1 + 1e-9);
-    return std::min({ b0, b1, b2 }) - std::max({ a0, a1, a2 }) >= g ||
-      std::min({ a0, a1, a2 }) - std::max({ b0, b1, b2 }) >= g;
-  }
-  // Do d and e lie strictly on one side of the plane through a with normal n, each at an angle
-  // of at least 1e-6 radians from it as seen from a?
-  static bool oneSide(const Vec3& a, const Vec3& n, const Vec3& d, const Vec3& e)
-  {
-    const Vec3 ad = d - a, ae = e - a;
-    const double sd = n.dot(ad), se = n.dot(ae);
-    const double nn = n.norm();
-    const double td = 1e-6 * nn * ad.norm(), te = 1e-6 * nn * ae.norm();
-    return (sd > td && se > te) || (sd < -td && se < -te);
-  }
-  template <typename A, typename B>
-  static bool separatedByAxes(const A& a, const B& b, double gap)
-  {
-    if (separated(a.Pts, b.Pts, b.C - a.C, gap) || separated(a.Pts, b.Pts, a.N, gap))
-      return true;
-    const Vec3 nb = (b.Pts[1] - b.Pts[0]).cross(b.Pts[2] - b.Pts[0]);
-    if (separated(a.Pts, b.Pts, nb, gap))
-      return true;
-    for (int k = 0; k < 3; ++k)
-      if (separated(a.Pts, b.Pts, a.N.cross(a.Pts[(k + 1) % 3] - a.Pts[k]), gap) ||
-        separated(a.Pts, b.Pts, nb.cross(b.Pts[(k + 1) % 3] - b.Pts[k]), gap))
-        return true;
-    return false;
+    LocalChangePolicy p;
+    p.MinimumTriangleQuality = o.MinimumTriangleQuality;
+    p.MinimumNormalCosine = o.MinimumNormalCosine;
+    p.Clearance = o.Clearance;
+    p.Input = o.EnforceClearance ? LocalChangePolicy::InputTest::Bounded : LocalChangePolicy::InputTest::None;
+    p.CheckSelfIntersection = o.EnforceNoSelfIntersection;
+    p.SelfClearance = o.selfClearance();
+    return p;
   }
 
   // Gradient descent on Psi (eq. 5-6): move the placement so that the new one-ring moves away from
@@ -1086,7 +831,7 @@ private:
         }
       }
       // the placement reached by the previous step: checked unless a sample already fails it
-      if (it > 0 && nearest >= Opt.Clearance && check(p, ev) == Verdict::Ok)
+      if (it > 0 && nearest >= Opt.Clearance && check(p, ev) == LocalChangeVerdict::Accepted)
         return true;
       if (it == Opt.PlacementIterations)
         return false;
@@ -1097,13 +842,13 @@ private:
     }
   }
 
-  static void countReject(Verdict v, Eval& ev)
+  static void countReject(LocalChangeVerdict v, Eval& ev)
   {
-    if (v == Verdict::Input)
+    if (v == LocalChangeVerdict::InputClearance)
       ++ev.RejInput;
-    else if (v == Verdict::Self)
+    else if (v == LocalChangeVerdict::Fold || v == LocalChangeVerdict::SelfIntersection)
       ++ev.RejSelf;
-    else if (v == Verdict::Shape)
+    else if (v == LocalChangeVerdict::Shape)
       ++ev.RejShape;
   }
 
@@ -1237,6 +982,7 @@ private:
   int Retries = 0;
   double PlacementReach = std::numeric_limits<double>::infinity();
   static constexpr int MaxRetries = 16;
+  LocalChangeVeto Veto; // reads P, T, TAlive and Grid
 };
 
 } // namespace
