@@ -20,7 +20,6 @@ namespace sdfcage_vtk
 namespace
 {
 
-
 //------------------------------------------------------------------------------
 // Appends the cells of `cells` to `mesh`. Polygons are copied as they are (Core triangulates
 // them and reports what it could not split). Triangle strips are split here; the degenerate
@@ -110,8 +109,7 @@ void ToPolygonMesh(vtkPolyData* input, sdfcage::PolygonMesh& mesh)
   AppendCells(input->GetLines(), CellKind::Line, mesh);
 }
 
-void ToPolyData(
-  const sdfcage::TriangleMesh& mesh, const std::vector<double>& distance, vtkPolyData* output)
+void ToPolyData(const sdfcage::TriangleMesh& mesh, const std::vector<double>& distance, vtkPolyData* output)
 {
   const vtkIdType numberOfPoints = static_cast<vtkIdType>(mesh.numberOfPoints());
   const vtkIdType numberOfTriangles = static_cast<vtkIdType>(mesh.numberOfTriangles());
@@ -159,8 +157,7 @@ void ToPolyData(
 void ToImageData(const sdfcage::ScalarImage& field, vtkImageData* output, const char* name)
 {
   const auto& dims = field.Dimensions;
-  const std::size_t count =
-    static_cast<std::size_t>(dims[0]) * static_cast<std::size_t>(dims[1]) * dims[2];
+  const std::size_t count = static_cast<std::size_t>(dims[0]) * static_cast<std::size_t>(dims[1]) * dims[2];
   if (dims[0] <= 0 || dims[1] <= 0 || dims[2] <= 0 || field.Values.size() != count)
   {
     return;
@@ -202,7 +199,6 @@ const char* StatusIdentifier(sdfcage::Status status)
   }
 }
 
-
 void AddResultArrays(vtkFieldData* fd, const sdfcage::ResultTable& results)
 {
   for (const sdfcage::ResultField& f : results)
@@ -239,7 +235,9 @@ const char* ResultText(const sdfcage::ResultTable& results, const char* name)
 
 const char* ResultName(const sdfcage::ResultTable& results, int index)
 {
-  return index >= 0 && static_cast<std::size_t>(index) < results.size() ? results[static_cast<std::size_t>(index)].Name.c_str() : "";
+  return index >= 0 && static_cast<std::size_t>(index) < results.size()
+    ? results[static_cast<std::size_t>(index)].Name.c_str()
+    : "";
 }
 
 } // namespace sdfcage_vtk

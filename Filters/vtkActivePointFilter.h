@@ -98,8 +98,14 @@ public:
    * the time in seconds, the status ("Ok", "EmptyInput", "InvalidInput", "Cancelled", "Failed")
    * and the last error message.
    */
-  vtkIdType GetNumberOfActivePoints() const { return static_cast<vtkIdType>(this->GetResultNumber("NumberOfActivePoints")); }
-  vtkIdType GetNumberOfActiveSamples() const { return static_cast<vtkIdType>(this->GetResultNumber("NumberOfActiveSamples")); }
+  vtkIdType GetNumberOfActivePoints() const
+  {
+    return static_cast<vtkIdType>(this->GetResultNumber("NumberOfActivePoints"));
+  }
+  vtkIdType GetNumberOfActiveSamples() const
+  {
+    return static_cast<vtkIdType>(this->GetResultNumber("NumberOfActiveSamples"));
+  }
   vtkIdType GetNumberOfSamples() const { return static_cast<vtkIdType>(this->GetResultNumber("NumberOfSamples")); }
   double GetActivePointTime() const { return this->GetResultNumber("ActivePointTime"); }
   double GetExecutionTime() const { return this->GetActivePointTime(); } ///< the old name of GetActivePointTime

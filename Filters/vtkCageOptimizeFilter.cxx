@@ -119,8 +119,8 @@ int vtkCageOptimizeFilter::FillInputPortInformation(int port, vtkInformation* in
 }
 
 //------------------------------------------------------------------------------
-int vtkCageOptimizeFilter::RequestData(vtkInformation* vtkNotUsed(request),
-  vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+int vtkCageOptimizeFilter::RequestData(
+  vtkInformation* vtkNotUsed(request), vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   this->ResetResults();
   vtkPolyData* cage = vtkPolyData::GetData(inputVector[0], 0);
@@ -160,12 +160,14 @@ int vtkCageOptimizeFilter::RequestData(vtkInformation* vtkNotUsed(request),
     const sdfcage::MeshDefects dc = sdfcage::prepareMesh(cagePolygons, cageMesh);
     if (!dc.usable())
     {
-      return fail(StatusIdentifier(sdfcage::Status::InvalidInput), "The cage (input 0) is not usable: " + dc.errorMessage());
+      return fail(
+        StatusIdentifier(sdfcage::Status::InvalidInput), "The cage (input 0) is not usable: " + dc.errorMessage());
     }
     const sdfcage::MeshDefects ds = sdfcage::prepareMesh(sourcePolygons, sourceMesh);
     if (!ds.usableAsInput()) // open and soup sources are fine, as for the cage filter
     {
-      return fail(StatusIdentifier(sdfcage::Status::InvalidInput), "The source mesh (input 1) is not usable: " + ds.inputErrorMessage());
+      return fail(StatusIdentifier(sdfcage::Status::InvalidInput),
+        "The source mesh (input 1) is not usable: " + ds.inputErrorMessage());
     }
 
     sdfcage::OptimizeOptions options;
@@ -195,8 +197,8 @@ int vtkCageOptimizeFilter::RequestData(vtkInformation* vtkNotUsed(request),
         publish();
         return 1;
       default:
-        return fail(this->StatusString, "Cage optimization failed: " +
-            (r.Message.empty() ? std::string("no reason given") : r.Message));
+        return fail(this->StatusString,
+          "Cage optimization failed: " + (r.Message.empty() ? std::string("no reason given") : r.Message));
     }
     if (r.Reverted)
     {

@@ -89,9 +89,7 @@ void ToTriangles(vtkPolyData* data, sdfcage::TriangleMesh& mesh, std::vector<vtk
     data->GetPoint(i, p);
     mesh.Points[static_cast<std::size_t>(i)] = sdfcage::Vec3(p[0], p[1], p[2]);
   }
-  auto toInt = [](vtkIdType id) {
-    return id < 0 || id > std::numeric_limits<int>::max() ? -1 : static_cast<int>(id);
-  };
+  auto toInt = [](vtkIdType id) { return id < 0 || id > std::numeric_limits<int>::max() ? -1 : static_cast<int>(id); };
   vtkIdType cellId = data->GetNumberOfVerts() + data->GetNumberOfLines();
   vtkIdType npts = 0;
   const vtkIdType* pts = nullptr;
@@ -197,8 +195,8 @@ void vtkCageQualityFilter::ResetResults()
 }
 
 //------------------------------------------------------------------------------
-int vtkCageQualityFilter::RequestData(vtkInformation* vtkNotUsed(request),
-  vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+int vtkCageQualityFilter::RequestData(
+  vtkInformation* vtkNotUsed(request), vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   this->ResetResults();
   vtkPolyData* cage = vtkPolyData::GetData(inputVector[0], 0);

@@ -103,8 +103,14 @@ public:
   double GetMeanDistanceCageToInput() const { return this->GetResultNumber("MeanDistanceCageToInput"); }
   double GetMeanDistanceCageToInputRelative() const { return this->GetResultNumber("MeanDistanceCageToInputRelative"); }
   vtkIdType GetSelfIntersections() const { return static_cast<vtkIdType>(this->GetResultNumber("SelfIntersections")); }
-  vtkIdType GetInputIntersections() const { return static_cast<vtkIdType>(this->GetResultNumber("InputIntersections")); }
-  vtkIdType GetInputVerticesOutside() const { return static_cast<vtkIdType>(this->GetResultNumber("InputVerticesOutside")); }
+  vtkIdType GetInputIntersections() const
+  {
+    return static_cast<vtkIdType>(this->GetResultNumber("InputIntersections"));
+  }
+  vtkIdType GetInputVerticesOutside() const
+  {
+    return static_cast<vtkIdType>(this->GetResultNumber("InputVerticesOutside"));
+  }
   int GetCageGenus() const { return static_cast<int>(this->GetResultNumber("CageGenus")); }
   int GetInputGenus() const { return static_cast<int>(this->GetResultNumber("InputGenus")); }
   double GetQualityTime() const { return this->GetResultNumber("QualityTime"); }

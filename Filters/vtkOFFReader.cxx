@@ -151,9 +151,8 @@ HeaderKind ClassifyHeader(const std::string& token)
   if (!endsWithOFF)
   {
     // no keyword: the file starts directly with the counts
-    return std::isdigit(static_cast<unsigned char>(token[0])) || token[0] == '+'
-      ? HeaderKind::Counts
-      : HeaderKind::Invalid;
+    return std::isdigit(static_cast<unsigned char>(token[0])) || token[0] == '+' ? HeaderKind::Counts
+                                                                                 : HeaderKind::Invalid;
   }
   std::string prefix = token.substr(0, token.size() - 3);
   bool unsupported = false;
@@ -224,8 +223,8 @@ int vtkOFFReader::CanReadFile(const char* fileName)
 }
 
 //------------------------------------------------------------------------------
-int vtkOFFReader::RequestData(vtkInformation* vtkNotUsed(request),
-  vtkInformationVector** vtkNotUsed(inputVector), vtkInformationVector* outputVector)
+int vtkOFFReader::RequestData(vtkInformation* vtkNotUsed(request), vtkInformationVector** vtkNotUsed(inputVector),
+  vtkInformationVector* outputVector)
 {
   vtkPolyData* output = vtkPolyData::GetData(outputVector, 0);
   if (!output)
@@ -383,8 +382,7 @@ int vtkOFFReader::RequestData(vtkInformation* vtkNotUsed(request),
       if (id < 0 || id >= numberOfPoints)
       {
         std::ostringstream msg;
-        msg << "face " << f << " uses vertex index " << id << ", outside [0, " << numberOfPoints
-            << ")";
+        msg << "face " << f << " uses vertex index " << id << ", outside [0, " << numberOfPoints << ")";
         return error(msg.str());
       }
       ids[static_cast<std::size_t>(k)] = static_cast<vtkIdType>(id);

@@ -94,8 +94,7 @@ void vtkOFFWriter::WriteData()
   }
 
   const vtkIdType numberOfPoints = input->GetNumberOfPoints();
-  out << "OFF\n# written by SDFCage vtkOFFWriter\n"
-      << numberOfPoints << " " << numberOfFaces << " 0\n";
+  out << "OFF\n# written by SDFCage vtkOFFWriter\n" << numberOfPoints << " " << numberOfFaces << " 0\n";
 
   // %.17g round-trips every double; snprintf is several times faster than iostreams here.
   char buffer[128];

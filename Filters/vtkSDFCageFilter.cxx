@@ -39,7 +39,6 @@
 
 vtkStandardNewMacro(vtkSDFCageFilter);
 
-
 using namespace sdfcage_vtk;
 
 //------------------------------------------------------------------------------
@@ -142,8 +141,8 @@ std::string OrNoReason(const std::string& message)
 } // namespace
 
 //------------------------------------------------------------------------------
-int vtkSDFCageFilter::RequestData(vtkInformation* vtkNotUsed(request),
-  vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+int vtkSDFCageFilter::RequestData(
+  vtkInformation* vtkNotUsed(request), vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
   this->ResetResults();
 
@@ -262,8 +261,7 @@ int vtkSDFCageFilter::DeliverOutputs(
     case sdfcage::Status::VerificationFailed:
       // Keep the unverified envelope for inspection; the cage stays empty.
       ToPolyData(result.Envelope, result.EnvelopeDistanceToInput, envelope);
-      return this->Fail(
-        this->StatusString, "The envelope could not be verified: " + OrNoReason(result.Message), cage);
+      return this->Fail(this->StatusString, "The envelope could not be verified: " + OrNoReason(result.Message), cage);
     case sdfcage::Status::Failed:
     default:
       return this->Fail(this->StatusString, "Cage generation failed: " + OrNoReason(result.Message), cage);
@@ -341,8 +339,7 @@ void vtkSDFCageFilter::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "AmplificationAlpha: " << this->AmplificationAlpha << "\n";
   os << indent << "AmplificationBeta: " << this->AmplificationBeta << "\n";
   os << indent << "SignMode: " << this->SignMode << "\n";
-  os << indent << "GenerateDistanceField: " << (this->GenerateDistanceField ? "On" : "Off")
-     << "\n";
+  os << indent << "GenerateDistanceField: " << (this->GenerateDistanceField ? "On" : "Off") << "\n";
   os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";
   os << indent << "Optimize: " << (this->Optimize ? "On" : "Off") << "\n";
   os << indent << "Energy: " << (this->Energy == 1 ? "Spacing" : "MIPS") << "\n";

@@ -383,8 +383,7 @@ private:
   void ResetResults();
   int RejectInput(vtkPolyData* input, vtkPolyData* cage);
   int Fail(const std::string& status, const std::string& message, vtkPolyData* cage);
-  int DeliverOutputs(const sdfcage::CageResult& result, vtkPolyData* cage, vtkPolyData* envelope,
-    vtkImageData* field);
+  int DeliverOutputs(const sdfcage::CageResult& result, vtkPolyData* cage, vtkPolyData* envelope, vtkImageData* field);
   void WarnAbout(const sdfcage::CageResult& result);
   void PublishResults(vtkPolyData* cage) const;
   long long ResultInteger(const char* name) const;

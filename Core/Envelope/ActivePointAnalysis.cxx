@@ -29,7 +29,8 @@ ActivePointAnalysis analyzeActivePoints(
   result.Defects = prepareMesh(input, result.Mesh, options.Validation);
   if (!result.Defects.usableAsInput())
   {
-    const bool nothing = result.Defects.Empty && result.Defects.NonFinitePoints == 0 && result.Defects.InvalidPointIds == 0;
+    const bool nothing =
+      result.Defects.Empty && result.Defects.NonFinitePoints == 0 && result.Defects.InvalidPointIds == 0;
     result.State = nothing ? Status::EmptyInput : Status::InvalidInput;
     result.Message = result.Defects.inputErrorMessage();
     result.Mesh = TriangleMesh();

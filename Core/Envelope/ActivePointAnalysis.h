@@ -34,8 +34,8 @@ struct ActivePointAnalysis
   std::size_t NumberOfActivePoints = 0;  ///< Mesh points flagged active
   std::size_t NumberOfActiveSamples = 0; ///< size of the active set on the surface sampling
   std::size_t NumberOfSamples = 0;
-  ScalarImage SignedDistance;            ///< xi, input coordinates and units (GenerateFields)
-  ScalarImage ModifiedSignedDistance;    ///< phi * xi, same grid
+  ScalarImage SignedDistance;         ///< xi, input coordinates and units (GenerateFields)
+  ScalarImage ModifiedSignedDistance; ///< phi * xi, same grid
   double Seconds = 0.0;
 };
 

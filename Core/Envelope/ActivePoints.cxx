@@ -109,8 +109,8 @@ private:
   };
   std::array<std::int64_t, 3> cellCoords(const Vec3& p) const
   {
-    return { static_cast<std::int64_t>(std::floor(p.x() / Cell)),
-      static_cast<std::int64_t>(std::floor(p.y() / Cell)), static_cast<std::int64_t>(std::floor(p.z() / Cell)) };
+    return { static_cast<std::int64_t>(std::floor(p.x() / Cell)), static_cast<std::int64_t>(std::floor(p.y() / Cell)),
+      static_cast<std::int64_t>(std::floor(p.z() / Cell)) };
   }
   static std::uint64_t key(const std::array<std::int64_t, 3>& c)
   {
@@ -344,7 +344,8 @@ std::vector<int> ballCentres(const std::vector<Vec3>& points, const std::vector<
   for (std::size_t k = 0; k < samples.size(); ++k)
   {
     const Vec3& x = points[samples[k]];
-    keyed[k] = { { static_cast<std::int64_t>(std::floor(x.x() / cell)), static_cast<std::int64_t>(std::floor(x.y() / cell)),
+    keyed[k] = { { static_cast<std::int64_t>(std::floor(x.x() / cell)),
+                   static_cast<std::int64_t>(std::floor(x.y() / cell)),
                    static_cast<std::int64_t>(std::floor(x.z() / cell)) },
       samples[k] };
   }
@@ -367,8 +368,8 @@ std::vector<int> ballCentres(const std::vector<Vec3>& points, const std::vector<
 class ActiveSampleDetection
 {
 public:
-  ActiveSampleDetection(const TriangleMesh& surface, const EdgeGraph& graph, const std::vector<int>& samples,
-    double r, double l, Progress* progress)
+  ActiveSampleDetection(const TriangleMesh& surface, const EdgeGraph& graph, const std::vector<int>& samples, double r,
+    double l, Progress* progress)
     : Points(surface.Points)
     , Samples(samples)
     , R(r)
@@ -408,8 +409,8 @@ private:
     {
     }
     BoundedDijkstra Search;
-    std::vector<char> IsCandidate; // 0 outside testSample()
-    std::vector<int> Candidates;            // of the sample being tested
+    std::vector<char> IsCandidate;           // 0 outside testSample()
+    std::vector<int> Candidates;             // of the sample being tested
     std::vector<int> Unsettled, Certifiable; // near the ball being certified
   };
 
@@ -420,59 +421,61 @@ private:
   void certifyInactiveByBalls(const std::vector<int>& centres, double reach)
   {
     const double half = 0.5 * this->L, r = this->R;
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, centres.size(), 16), [&](const tbb::blocked_range<std::size_t>& range) {
-      if (this->Cancelled.load(std::memory_order_relaxed))
-      {
-        return;
-      }
-      Scratch& s = this->Scratches.local();
-      for (std::size_t k = range.begin(); k != range.end(); ++k)
-      {
-        const int c = centres[k];
-        s.Search.run(c, half, [](int, double) { return true; });
-        // a sample within `reach` (Euclidean) of c has all its candidates within reach + r of c:
-        // it is certified unless one of those is unsettled and near it
-        s.Unsettled.clear();
-        s.Certifiable.clear();
-        const Vec3& x = this->Points[c];
-        const double reach2 = reach * reach;
-        this->SampleGrid.forEachWithin(x, reach + r, [&](int w) {
-          if (!s.Search.settled(w))
-          {
-            s.Unsettled.push_back(w);
-          }
-          else if ((this->Points[w] - x).squaredNorm() <= reach2 && !this->Certified[w].load(std::memory_order_relaxed))
-          {
-            s.Certifiable.push_back(w);
-          }
-        });
-        const double r2 = r * r;
-        for (int q : s.Certifiable)
+    tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, centres.size(), 16), [&](const tbb::blocked_range<std::size_t>& range) {
+        if (this->Cancelled.load(std::memory_order_relaxed))
         {
-          bool ok = true;
-          for (int u : s.Unsettled)
-          {
-            if ((this->Points[u] - this->Points[q]).squaredNorm() < r2)
+          return;
+        }
+        Scratch& s = this->Scratches.local();
+        for (std::size_t k = range.begin(); k != range.end(); ++k)
+        {
+          const int c = centres[k];
+          s.Search.run(c, half, [](int, double) { return true; });
+          // a sample within `reach` (Euclidean) of c has all its candidates within reach + r of c:
+          // it is certified unless one of those is unsettled and near it
+          s.Unsettled.clear();
+          s.Certifiable.clear();
+          const Vec3& x = this->Points[c];
+          const double reach2 = reach * reach;
+          this->SampleGrid.forEachWithin(x, reach + r, [&](int w) {
+            if (!s.Search.settled(w))
             {
-              ok = false;
-              break;
+              s.Unsettled.push_back(w);
+            }
+            else if ((this->Points[w] - x).squaredNorm() <= reach2 &&
+              !this->Certified[w].load(std::memory_order_relaxed))
+            {
+              s.Certifiable.push_back(w);
+            }
+          });
+          const double r2 = r * r;
+          for (int q : s.Certifiable)
+          {
+            bool ok = true;
+            for (int u : s.Unsettled)
+            {
+              if ((this->Points[u] - this->Points[q]).squaredNorm() < r2)
+              {
+                ok = false;
+                break;
+              }
+            }
+            if (ok)
+            {
+              this->Certified[q].store(1, std::memory_order_relaxed);
             }
           }
-          if (ok)
-          {
-            this->Certified[q].store(1, std::memory_order_relaxed);
-          }
         }
-      }
-      this->advance(range.size());
-    });
+        this->advance(range.size());
+      });
   }
 
   /// Every sample neither certified nor already found active goes through the three steps.
   void testSamples()
   {
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, this->Samples.size(), 512),
-      [&](const tbb::blocked_range<std::size_t>& range) {
+    tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, this->Samples.size(), 512), [&](const tbb::blocked_range<std::size_t>& range) {
         if (this->Cancelled.load(std::memory_order_relaxed))
         {
           return;
@@ -655,13 +658,13 @@ double ActivePoints::amplificationAt(int t, const Vec3& closest, double distance
   return this->phi(this->geodesicAt(t, w) + distance);
 }
 
-std::size_t splitEdges(TriangleMesh& mesh, const std::function<bool(int, int)>& split,
-  std::vector<std::array<int, 2>>* parents)
+std::size_t splitEdges(
+  TriangleMesh& mesh, const std::function<bool(int, int)>& split, std::vector<std::array<int, 2>>* parents)
 {
   std::unordered_map<std::uint64_t, int> midpoints;
   auto mid = [&](int a, int b) {
-    const std::uint64_t key = (static_cast<std::uint64_t>(std::min(a, b)) << 32) |
-      static_cast<std::uint32_t>(std::max(a, b));
+    const std::uint64_t key =
+      (static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint32_t>(std::max(a, b));
     auto it = midpoints.find(key);
     if (it != midpoints.end())
     {
@@ -737,9 +740,8 @@ bool refineMesh(const TriangleMesh& mesh, double maxEdge, TriangleMesh& out, std
   const double m2 = maxEdge * maxEdge;
   for (int round = 0; round < 64; ++round)
   {
-    const std::size_t created = splitEdges(out, [&](int a, int b) {
-      return (out.Points[a] - out.Points[b]).squaredNorm() > m2;
-    });
+    const std::size_t created =
+      splitEdges(out, [&](int a, int b) { return (out.Points[a] - out.Points[b]).squaredNorm() > m2; });
     if (created == 0)
     {
       return true;

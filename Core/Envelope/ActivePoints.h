@@ -43,13 +43,14 @@ struct ActivePointOptions
 /// the points inserted on split edges; the same shape) with per-point values.
 struct ActivePoints
 {
-  TriangleMesh Surface;                  ///< refined input, unit-sphere units
-  std::size_t NumberOfInputPoints = 0;   ///< Surface.Points[0, n) are the input's points
-  std::vector<std::uint8_t> Active;      ///< per Surface point: 1 = active (sample or within half a spacing of an active sample)
-  std::vector<double> GeodesicToActive;  ///< g_A per Surface point, clamped to the cutoff
-  std::size_t NumberOfSamples = 0;       ///< points tested
-  std::size_t NumberOfActiveSamples = 0; ///< samples found active (the active set A)
-  std::size_t NumberOfActivePoints = 0;  ///< Surface points flagged in Active
+  TriangleMesh Surface;                ///< refined input, unit-sphere units
+  std::size_t NumberOfInputPoints = 0; ///< Surface.Points[0, n) are the input's points
+  std::vector<std::uint8_t>
+    Active; ///< per Surface point: 1 = active (sample or within half a spacing of an active sample)
+  std::vector<double> GeodesicToActive;      ///< g_A per Surface point, clamped to the cutoff
+  std::size_t NumberOfSamples = 0;           ///< points tested
+  std::size_t NumberOfActiveSamples = 0;     ///< samples found active (the active set A)
+  std::size_t NumberOfActivePoints = 0;      ///< Surface points flagged in Active
   std::size_t NumberOfActiveInputPoints = 0; ///< of those, input points
   double Alpha = 3.0;
   double Beta = 8.0;
@@ -77,12 +78,11 @@ ActivePoints computeActivePoints(
 /// One round of conforming red-green refinement: every edge for which split(a, b) (symmetric)
 /// holds gets its midpoint, appended to mesh.Points (with its edge in `parents`); triangles are
 /// split 1-2, 1-3 or 1-4 keeping their orientation. Returns the number of midpoints added.
-std::size_t splitEdges(TriangleMesh& mesh, const std::function<bool(int, int)>& split,
-  std::vector<std::array<int, 2>>* parents = nullptr);
+std::size_t splitEdges(
+  TriangleMesh& mesh, const std::function<bool(int, int)>& split, std::vector<std::array<int, 2>>* parents = nullptr);
 
 /// Splits edges (conforming red-green refinement) until none is longer than `maxEdge`; the
 /// points of `mesh` keep their indices. Stops after `maxTriangles` triangles (returns false).
-bool refineMesh(const TriangleMesh& mesh, double maxEdge, TriangleMesh& refined,
-  std::size_t maxTriangles = 20000000);
+bool refineMesh(const TriangleMesh& mesh, double maxEdge, TriangleMesh& refined, std::size_t maxTriangles = 20000000);
 
 } // namespace sdfcage

@@ -135,7 +135,6 @@ TriangleMesh outerBoundary(const TriangleMesh& surface, int& removed)
   return keepTriangles(surface, keep);
 }
 
-
 /// Flags every triangle of `surface` that crosses another one (beyond shared vertices/edges);
 /// with `only`, just the triangles it selects are tested (against all the others).
 void markSelfIntersecting(const TriangleMesh& surface, std::vector<char>& bad, const std::vector<char>* only = nullptr)
@@ -233,7 +232,7 @@ std::size_t projectOntoAmplifiedOffset(
   TriangleMesh& envelope, const ActivePoints& amp, const TriangleTree& tree, double c, double maxEdge)
 {
   std::vector<char> amplified;
-  std::vector<double> offset; // distance to the input after the projection
+  std::vector<double> offset;                   // distance to the input after the projection
   std::vector<Vec3> original = envelope.Points; // where the grid put them (midpoints: of the chord)
   std::atomic<std::size_t> moved{ 0 };
   // phi - 1 <= 1e-3 (alpha - 1), below which nothing moves, once d^ >= sqrt(ln 1000) / beta. As
@@ -401,8 +400,8 @@ const char* signModeName(SignMode m)
   return "unknown";
 }
 
-EnvelopeResult buildEnvelope(
-  const TriangleMesh& unitInput, const EnvelopeOptions& options, Progress* progress, double progressEnd, int inputClosed)
+EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOptions& options, Progress* progress,
+  double progressEnd, int inputClosed)
 {
   EnvelopeResult result;
   if (unitInput.empty())
@@ -539,8 +538,8 @@ EnvelopeResult buildEnvelope(
       std::string why;
       double clearance = 0.0;
       std::vector<double> distances;
-      const bool ok = verifyEnclosure(unitInput, envelope, delta, clearance, why, &distances, progress,
-        options.ExactEnvelopeClearance, &tree());
+      const bool ok = verifyEnclosure(
+        unitInput, envelope, delta, clearance, why, &distances, progress, options.ExactEnvelopeClearance, &tree());
       ++attempt;
       if (ok)
       {
@@ -603,8 +602,8 @@ EnvelopeResult buildEnvelope(
       {
         std::ostringstream w;
         w << "the envelope has genus " << result.Genus << " and " << result.Components
-          << " component(s), the input genus " << result.InputGenus << " and "
-          << result.InputComponents << ": parts of the input closer than the parameters can "
+          << " component(s), the input genus " << result.InputGenus << " and " << result.InputComponents
+          << ": parts of the input closer than the parameters can "
           << "separate were fused";
         if (!useActivePoints)
         {
@@ -626,8 +625,8 @@ EnvelopeResult buildEnvelope(
   }
   result.State = Status::VerificationFailed;
   result.EnclosureVerified = false;
-  result.Message += " (after " + std::to_string(attempt) +
-    " attempts with finer grids; try a larger IsoValue or a smaller VoxelSize)";
+  result.Message +=
+    " (after " + std::to_string(attempt) + " attempts with finer grids; try a larger IsoValue or a smaller VoxelSize)";
   return result;
 }
 

@@ -78,34 +78,35 @@ struct EnvelopeResult
 {
   Status State = Status::Failed;
   SignMode SignUsed = SignMode::FloodFill; ///< the inside rule actually used (never Auto)
-  std::string SignReason;           ///< why that rule (Auto's choice or the request)
-  bool InputClosed = false;         ///< the input is a closed, consistently oriented 2-manifold
-  std::string Message;              ///< what went wrong (empty when Ok)
-  TriangleMesh Envelope;            ///< outer envelope, outward oriented, unit-sphere units
-  std::vector<double> DistanceToInput; ///< per envelope point, unsigned, unit-sphere units
-  double MinimumClearance = 0.0;    ///< exact min distance to the input (ExactEnvelopeClearance) or a certified lower bound >= delta, unit-sphere units
-  bool EnclosureVerified = false;   ///< clearance >= delta, input inside, closed manifold
-  int RemovedPockets = 0;           ///< trapped air pockets (inner components) removed
-  int Components = 0;               ///< components of the kept envelope
-  int Genus = 0;                    ///< genus of the kept envelope
-  double VoxelSizeUsed = 0.0;       ///< after any refinement
-  int Refinements = 0;              ///< finer grids needed (0: the requested voxel size)
+  std::string SignReason;                  ///< why that rule (Auto's choice or the request)
+  bool InputClosed = false;                ///< the input is a closed, consistently oriented 2-manifold
+  std::string Message;                     ///< what went wrong (empty when Ok)
+  TriangleMesh Envelope;                   ///< outer envelope, outward oriented, unit-sphere units
+  std::vector<double> DistanceToInput;     ///< per envelope point, unsigned, unit-sphere units
+  double MinimumClearance =
+    0.0; ///< exact min distance to the input (ExactEnvelopeClearance) or a certified lower bound >= delta, unit-sphere units
+  bool EnclosureVerified = false;    ///< clearance >= delta, input inside, closed manifold
+  int RemovedPockets = 0;            ///< trapped air pockets (inner components) removed
+  int Components = 0;                ///< components of the kept envelope
+  int Genus = 0;                     ///< genus of the kept envelope
+  double VoxelSizeUsed = 0.0;        ///< after any refinement
+  int Refinements = 0;               ///< finer grids needed (0: the requested voxel size)
   std::size_t ProjectedVertices = 0; ///< vertices moved onto the exact amplified offset
-  int AdaptiveRepairs = 0;          ///< re-extractions with adaptivity switched off around defects
-  double AdaptivityUsed = 0.0;      ///< adaptivity of the accepted envelope
+  int AdaptiveRepairs = 0;           ///< re-extractions with adaptivity switched off around defects
+  double AdaptivityUsed = 0.0;       ///< adaptivity of the accepted envelope
   double DistanceFieldSeconds = 0.0;
   double IsosurfaceSeconds = 0.0;
   double VerificationSeconds = 0.0;
-  ScalarImage DistanceField;        ///< filled when KeepDistanceField (unit-sphere units)
-  ScalarImage ModifiedDistanceField; ///< phi * xi, filled when KeepDistanceField and active points exist
+  ScalarImage DistanceField;             ///< filled when KeepDistanceField (unit-sphere units)
+  ScalarImage ModifiedDistanceField;     ///< phi * xi, filled when KeepDistanceField and active points exist
   std::size_t NumberOfActivePoints = 0;  ///< input points flagged active
   std::size_t NumberOfActiveSamples = 0; ///< size of the active set A (samples)
   std::size_t AmplifiedVoxels = 0;       ///< voxels where phi > 1.001
-  double ActivePointSeconds = 0.0;   ///< active points + g_A
-  double AmplificationSeconds = 0.0; ///< xi -> phi xi on the grid (included in DistanceFieldSeconds)
-  double WindingSeconds = 0.0;       ///< winding-number sign (included in DistanceFieldSeconds)
-  std::size_t WindingEvaluations = 0; ///< voxels whose winding number was evaluated
-  int InputGenus = 0;               ///< -1 where undefined (the input is not closed)
+  double ActivePointSeconds = 0.0;       ///< active points + g_A
+  double AmplificationSeconds = 0.0;     ///< xi -> phi xi on the grid (included in DistanceFieldSeconds)
+  double WindingSeconds = 0.0;           ///< winding-number sign (included in DistanceFieldSeconds)
+  std::size_t WindingEvaluations = 0;    ///< voxels whose winding number was evaluated
+  int InputGenus = 0;                    ///< -1 where undefined (the input is not closed)
   int InputComponents = 0;
   /// Non-empty when the envelope's genus or component count differs from the input's (parts
   /// closer than the parameters can separate were fused, or handles closed): the envelope is

@@ -69,8 +69,8 @@ std::once_flag vdbInit;
 double phiAt(const ActivePoints& amp, const Vec3& x, int triangle, double distance)
 {
   const Triangle& t = amp.Surface.Triangles[triangle];
-  const Vec3 closest = closestPointOnTriangle(
-    x, amp.Surface.Points[t[0]], amp.Surface.Points[t[1]], amp.Surface.Points[t[2]]);
+  const Vec3 closest =
+    closestPointOnTriangle(x, amp.Surface.Points[t[0]], amp.Surface.Points[t[1]], amp.Surface.Points[t[2]]);
   return amp.amplificationAt(triangle, closest, distance);
 }
 
@@ -93,20 +93,21 @@ std::vector<int> mortonOrder(const std::vector<openvdb::Vec3s>& points, const st
     lo = openvdb::math::minComponent(lo, p);
   }
   std::vector<std::pair<std::uint64_t, int>> keys(triangles.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, triangles.size(), 8192), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t f = r.begin(); f != r.end(); ++f)
-    {
-      const Triangle& t = triangles[f];
-      const openvdb::Vec3s c = (points[t[0]] + points[t[1]] + points[t[2]]) / 3.0f - lo;
-      std::uint64_t code = 0;
-      for (int a = 0; a < 3; ++a)
+  tbb::parallel_for(
+    tbb::blocked_range<std::size_t>(0, triangles.size(), 8192), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t f = r.begin(); f != r.end(); ++f)
       {
-        const double cell = std::floor(std::max(0.0, static_cast<double>(c[a])) / 2.0);
-        code |= spread(static_cast<std::uint64_t>(std::min(cell, 2097151.0))) << a;
+        const Triangle& t = triangles[f];
+        const openvdb::Vec3s c = (points[t[0]] + points[t[1]] + points[t[2]]) / 3.0f - lo;
+        std::uint64_t code = 0;
+        for (int a = 0; a < 3; ++a)
+        {
+          const double cell = std::floor(std::max(0.0, static_cast<double>(c[a])) / 2.0);
+          code |= spread(static_cast<std::uint64_t>(std::min(cell, 2097151.0))) << a;
+        }
+        keys[f] = { code, static_cast<int>(f) };
       }
-      keys[f] = { code, static_cast<int>(f) };
-    }
-  });
+    });
   std::sort(keys.begin(), keys.end());
   std::vector<int> order(keys.size());
   for (std::size_t f = 0; f < keys.size(); ++f)
@@ -171,10 +172,10 @@ std::size_t amplify(openvdb::FloatGrid& grid, const openvdb::Int32Grid& index, c
   return changed.load();
 }
 
-
 /// The isosurface {value = iso} of `grid` (unit-sphere units), quads split on the shorter
 /// diagonal, counter-clockwise seen from outside; no adaptivity inside `noAdapt`.
-TriangleMesh extract(const openvdb::FloatGrid& grid, double iso, double adaptivity, const openvdb::BoolTree::Ptr& noAdapt)
+TriangleMesh extract(
+  const openvdb::FloatGrid& grid, double iso, double adaptivity, const openvdb::BoolTree::Ptr& noAdapt)
 {
   openvdb::tools::VolumeToMesh mesher(iso, adaptivity, true);
   if (noAdapt && adaptivity > 0.0)
@@ -282,8 +283,8 @@ bool computeDisplayFields(const TriangleMesh& unitMesh, double iso, double minSp
   try
   {
     openvdb::util::NullInterrupter none;
-    grid = openvdb::tools::meshToVolume<openvdb::FloatGrid>(none, coarseAdapter, *coarseTransform,
-      band, std::numeric_limits<float>::max(), 0, displayTriangle.get());
+    grid = openvdb::tools::meshToVolume<openvdb::FloatGrid>(
+      none, coarseAdapter, *coarseTransform, band, std::numeric_limits<float>::max(), 0, displayTriangle.get());
   }
   catch (const std::exception& e)
   {
@@ -339,10 +340,9 @@ bool computeDisplayFields(const TriangleMesh& unitMesh, double iso, double minSp
   return true;
 }
 
-IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSize, double iso,
-  bool keepField, Progress* progress, const std::vector<double>& adaptivities,
-  const ActivePoints* amplification, const SurfaceJudge* judge, int maxRepairs, SignMode sign,
-  const TriangleTree* windingTree)
+IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSize, double iso, bool keepField,
+  Progress* progress, const std::vector<double>& adaptivities, const ActivePoints* amplification,
+  const SurfaceJudge* judge, int maxRepairs, SignMode sign, const TriangleTree* windingTree)
 {
   std::call_once(vdbInit, []() { openvdb::initialize(); });
   if (amplification && amplification->empty())
@@ -390,9 +390,8 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
   }
   try
   {
-    grid = openvdb::tools::meshToVolume<openvdb::FloatGrid>(
-      sdfInterrupter, adapter, *transform, exteriorBand, interiorBand,
-      unsignedField ? openvdb::tools::UNSIGNED_DISTANCE_FIELD : 0, closestTriangle.get());
+    grid = openvdb::tools::meshToVolume<openvdb::FloatGrid>(sdfInterrupter, adapter, *transform, exteriorBand,
+      interiorBand, unsignedField ? openvdb::tools::UNSIGNED_DISTANCE_FIELD : 0, closestTriangle.get());
   }
   catch (const std::exception& e)
   {
@@ -486,7 +485,9 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
     const float background = grid->background();
     using LeafT = openvdb::FloatTree::LeafNodeType;
     std::vector<char> filledLeaf(leaves.leafCount(), 0);
-    auto leafIndex = [&](const openvdb::tree::LeafManager<openvdb::FloatTree>::LeafRange::Iterator& it) { return it.pos(); };
+    auto leafIndex = [&](const openvdb::tree::LeafManager<openvdb::FloatTree>::LeafRange::Iterator& it) {
+      return it.pos();
+    };
     tbb::parallel_for(leaves.leafRange(), [&](const openvdb::tree::LeafManager<openvdb::FloatTree>::LeafRange& r) {
       std::size_t e = 0;
       for (auto leaf = r.begin(); leaf; ++leaf)
@@ -533,10 +534,10 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
         lo = lo.cwiseMin(p);
         hi = hi.cwiseMax(p);
       }
-      const int b0[3] = { static_cast<int>(std::floor(lo.x() / voxelSize)) & ~7, static_cast<int>(std::floor(lo.y() / voxelSize)) & ~7,
-        static_cast<int>(std::floor(lo.z() / voxelSize)) & ~7 };
-      const int b1[3] = { static_cast<int>(std::ceil(hi.x() / voxelSize)), static_cast<int>(std::ceil(hi.y() / voxelSize)),
-        static_cast<int>(std::ceil(hi.z() / voxelSize)) };
+      const int b0[3] = { static_cast<int>(std::floor(lo.x() / voxelSize)) & ~7,
+        static_cast<int>(std::floor(lo.y() / voxelSize)) & ~7, static_cast<int>(std::floor(lo.z() / voxelSize)) & ~7 };
+      const int b1[3] = { static_cast<int>(std::ceil(hi.x() / voxelSize)),
+        static_cast<int>(std::ceil(hi.y() / voxelSize)), static_cast<int>(std::ceil(hi.z() / voxelSize)) };
       std::vector<openvdb::Coord> blocks;
       for (int x = b0[0]; x <= b1[0]; x += 8)
         for (int y = b0[1]; y <= b1[1]; y += 8)
@@ -544,14 +545,15 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
             if (!grid->tree().probeConstLeaf(openvdb::Coord(x, y, z)))
               blocks.emplace_back(x, y, z);
       std::vector<char> insideBlock(blocks.size(), 0);
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks.size(), 256), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t i = r.begin(); i != r.end(); ++i)
-        {
-          const openvdb::Coord& c = blocks[i];
-          const Vec3 x((c.x() + 3.5) * voxelSize, (c.y() + 3.5) * voxelSize, (c.z() + 3.5) * voxelSize);
-          insideBlock[i] = std::abs(windingTree->windingNumber(x)) > 0.5;
-        }
-      });
+      tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, blocks.size(), 256), [&](const tbb::blocked_range<std::size_t>& r) {
+          for (std::size_t i = r.begin(); i != r.end(); ++i)
+          {
+            const openvdb::Coord& c = blocks[i];
+            const Vec3 x((c.x() + 3.5) * voxelSize, (c.y() + 3.5) * voxelSize, (c.z() + 3.5) * voxelSize);
+            insideBlock[i] = std::abs(windingTree->windingNumber(x)) > 0.5;
+          }
+        });
       evaluated += blocks.size();
       // as leaves of active voxels, not as tiles: the extraction leaves cracks at tile borders and
       // between inactive voxels
@@ -603,8 +605,8 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
     // phi >= 1, so only where xi <= iso (plus a voxel for the interpolation).
     const auto ta = std::chrono::steady_clock::now();
     noAdapt.reset(new openvdb::BoolTree(grid->tree(), false, openvdb::TopologyCopy()));
-    out.AmplifiedVoxels = amplify(*grid, *closestTriangle, order, *amplification, voxelSize,
-      static_cast<float>(iso + 2.0 * voxelSize), *noAdapt);
+    out.AmplifiedVoxels = amplify(
+      *grid, *closestTriangle, order, *amplification, voxelSize, static_cast<float>(iso + 2.0 * voxelSize), *noAdapt);
     openvdb::tools::dilateActiveValues(*noAdapt, 1);
     closestTriangle.reset();
     out.AmplificationSeconds = seconds(ta);
@@ -665,8 +667,8 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
 
   const auto tf = std::chrono::steady_clock::now();
   if (keepField &&
-    !computeDisplayFields(unitMesh, iso, voxelSize, amplification, out.Field,
-      amplification ? &out.ModifiedField : nullptr, out.Error))
+    !computeDisplayFields(
+      unitMesh, iso, voxelSize, amplification, out.Field, amplification ? &out.ModifiedField : nullptr, out.Error))
   {
     return out;
   }

@@ -20,20 +20,20 @@ struct IsosurfaceOutput
 {
   /// the isosurface {xi = iso} for each requested adaptivity, triangles (quads split), unit units
   std::vector<TriangleMesh> Surfaces;
-  ScalarImage Field;      ///< for display: xi on a coarser grid (<= 256 per axis), interior filled
+  ScalarImage Field;         ///< for display: xi on a coarser grid (<= 256 per axis), interior filled
   ScalarImage ModifiedField; ///< with amplification and keepField: phi * xi on the same grid
   bool Cancelled = false;
   std::string Error;
   double DistanceFieldSeconds = 0.0;
   double IsosurfaceSeconds = 0.0; ///< the extractions and the display field (not the judge's time)
   std::size_t ActiveVoxels = 0;
-  std::size_t AmplifiedVoxels = 0; ///< voxels whose value phi changed by more than 1e-3
-  double AmplificationSeconds = 0.0; ///< xi -> phi xi on the grid (part of DistanceFieldSeconds)
-  double WindingSeconds = 0.0;     ///< the winding-number sign (part of DistanceFieldSeconds)
+  std::size_t AmplifiedVoxels = 0;    ///< voxels whose value phi changed by more than 1e-3
+  double AmplificationSeconds = 0.0;  ///< xi -> phi xi on the grid (part of DistanceFieldSeconds)
+  double WindingSeconds = 0.0;        ///< the winding-number sign (part of DistanceFieldSeconds)
   std::size_t WindingEvaluations = 0; ///< voxels whose winding number was evaluated
-  std::size_t InsideVoxels = 0;    ///< of those, the ones found inside
-  double AcceptedAdaptivity = 0.0; ///< with a judge: the adaptivity of the accepted surface
-  int Repairs = 0;                 ///< with a judge: re-extractions with a larger no-adaptivity region
+  std::size_t InsideVoxels = 0;       ///< of those, the ones found inside
+  double AcceptedAdaptivity = 0.0;    ///< with a judge: the adaptivity of the accepted surface
+  int Repairs = 0;                    ///< with a judge: re-extractions with a larger no-adaptivity region
 };
 
 /// Judges an extracted surface: true accepts it. Otherwise `repairNear` may receive points (unit-
@@ -57,10 +57,10 @@ using SurfaceJudge = std::function<bool(const TriangleMesh& surface, double adap
 /// `windingTree` (the input's tree, prepareWindingNumbers() done) gives |w| > 1/2. The deep inside
 /// beyond the band reads as outside then and yields inward-facing pockets, which the envelope
 /// removes with the others.
-IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSize, double iso,
-  bool keepField, Progress* progress, const std::vector<double>& adaptivities = { 0.0 },
-  const ActivePoints* amplification = nullptr, const SurfaceJudge* judge = nullptr, int maxRepairs = 3,
-  SignMode sign = SignMode::FloodFill, const TriangleTree* windingTree = nullptr);
+IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSize, double iso, bool keepField,
+  Progress* progress, const std::vector<double>& adaptivities = { 0.0 }, const ActivePoints* amplification = nullptr,
+  const SurfaceJudge* judge = nullptr, int maxRepairs = 3, SignMode sign = SignMode::FloodFill,
+  const TriangleTree* windingTree = nullptr);
 
 /// For display: xi sampled on a regular grid over the mesh's box plus a margin (spacing at least
 /// `minSpacing`, at most ~256 samples per axis), interior filled, exterior band wide enough to

@@ -28,8 +28,8 @@ TriangleMesh makeSphere(const Vec3& center, double radius, int slices, int stack
     for (int j = 0; j < slices; ++j)
     {
       const double phi = 2.0 * M_PI * j / slices;
-      m.Points.push_back(center +
-        radius * Vec3(-std::cos(theta), std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi)));
+      m.Points.push_back(
+        center + radius * Vec3(-std::cos(theta), std::sin(theta) * std::cos(phi), std::sin(theta) * std::sin(phi)));
     }
   }
   m.Points.push_back(center + Vec3(radius, 0, 0));
@@ -61,8 +61,8 @@ TriangleMesh makeTorus(const Vec3& center, double R, double r, int nu, int nv)
     for (int j = 0; j < nv; ++j)
     {
       const double v = 2.0 * M_PI * j / nv;
-      m.Points.push_back(center +
-        Vec3((R + r * std::cos(v)) * std::cos(u), (R + r * std::cos(v)) * std::sin(u), r * std::sin(v)));
+      m.Points.push_back(
+        center + Vec3((R + r * std::cos(v)) * std::cos(u), (R + r * std::cos(v)) * std::sin(u), r * std::sin(v)));
     }
   }
   auto id = [&](int i, int j) { return ((i + nu) % nu) * nv + (j + nv) % nv; };
@@ -84,7 +84,8 @@ TriangleMesh makeBox(const Vec3& lo, const Vec3& hi)
   {
     m.Points.push_back(Vec3((k & 1) ? hi.x() : lo.x(), (k & 2) ? hi.y() : lo.y(), (k & 4) ? hi.z() : lo.z()));
   }
-  const int quads[6][4] = { { 0, 2, 3, 1 }, { 4, 5, 7, 6 }, { 0, 1, 5, 4 }, { 2, 6, 7, 3 }, { 0, 4, 6, 2 }, { 1, 3, 7, 5 } };
+  const int quads[6][4] = { { 0, 2, 3, 1 }, { 4, 5, 7, 6 }, { 0, 1, 5, 4 }, { 2, 6, 7, 3 }, { 0, 4, 6, 2 },
+    { 1, 3, 7, 5 } };
   for (const auto& q : quads)
   {
     m.Triangles.push_back({ q[0], q[1], q[2] });

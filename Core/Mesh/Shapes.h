@@ -13,7 +13,8 @@ TriangleMesh makeBuiltinShape(double gap = 0.012, int resolution = 1);
 
 /// UV sphere (closed, outward) and torus, for tests.
 TriangleMesh makeSphere(const Vec3& center, double radius, int slices, int stacks);
-TriangleMesh makeTorus(const Vec3& center, double majorRadius, double minorRadius, int majorSegments, int minorSegments);
+TriangleMesh makeTorus(
+  const Vec3& center, double majorRadius, double minorRadius, int majorSegments, int minorSegments);
 /// Axis-aligned box split into 12 triangles, outward.
 TriangleMesh makeBox(const Vec3& lo, const Vec3& hi);
 /// Appends b to a (offsets indices).

@@ -14,9 +14,8 @@ namespace sdfcage
 
 bool MeshDefects::usable() const
 {
-  return !Empty && NonFinitePoints == 0 && InvalidPointIds == 0 && UntriangulatedPolygons == 0 &&
-    BoundaryEdges == 0 && NonManifoldEdges == 0 && NonManifoldVertices == 0 &&
-    DegenerateTriangles == 0 && InconsistentEdges == 0;
+  return !Empty && NonFinitePoints == 0 && InvalidPointIds == 0 && UntriangulatedPolygons == 0 && BoundaryEdges == 0 &&
+    NonManifoldEdges == 0 && NonManifoldVertices == 0 && DegenerateTriangles == 0 && InconsistentEdges == 0;
 }
 
 std::string MeshDefects::errorMessage() const
@@ -63,8 +62,7 @@ std::string MeshDefects::errorMessage() const
   if (NonManifoldVertices)
   {
     sep();
-    s << NonManifoldVertices
-      << " non-manifold vertices (surface sheets touching at a single point)";
+    s << NonManifoldVertices << " non-manifold vertices (surface sheets touching at a single point)";
   }
   if (DegenerateTriangles)
   {
@@ -98,9 +96,9 @@ std::string MeshDefects::inputErrorMessage() const
   }
   if (Empty && msg.empty())
   {
-    add(DroppedDegenerateTriangles > 0
-        ? "the mesh has no triangles with a non-zero area (" + std::to_string(DroppedDegenerateTriangles) + " degenerate ones)"
-        : std::string("the mesh has no polygons (points or lines only, or nothing)"));
+    add(DroppedDegenerateTriangles > 0 ? "the mesh has no triangles with a non-zero area (" +
+          std::to_string(DroppedDegenerateTriangles) + " degenerate ones)"
+                                       : std::string("the mesh has no polygons (points or lines only, or nothing)"));
   }
   return msg.empty() ? msg : "Unusable input mesh: " + msg + ".";
 }
@@ -151,8 +149,8 @@ namespace
 
 // Fan-triangulates polygon ids (n >= 4) when it is planar and strictly convex. Returns false when
 // that is not safe (the split would depend on a choice the input does not determine).
-bool triangulateConvex(const std::vector<Vec3>& pts, const std::int64_t* ids, std::int64_t n,
-  std::vector<Triangle>& out)
+bool triangulateConvex(
+  const std::vector<Vec3>& pts, const std::int64_t* ids, std::int64_t n, std::vector<Triangle>& out)
 {
   Vec3 normal = Vec3::Zero(); // Newell normal
   Vec3 centroid = Vec3::Zero();
@@ -588,7 +586,8 @@ MeshDefects prepareMesh(const PolygonMesh& input, TriangleMesh& output, const Va
       }
       i = j;
     }
-    d.MergedPoints = mergeCoincidentPoints(input.Points, referenced, onBoundary, lo, any ? d.MergeTolerance : -1.0, rep);
+    d.MergedPoints =
+      mergeCoincidentPoints(input.Points, referenced, onBoundary, lo, any ? d.MergeTolerance : -1.0, rep);
   }
   auto id = [&](std::int64_t k) { return static_cast<int>(rep[input.Connectivity[k]]); };
 
@@ -637,7 +636,8 @@ MeshDefects prepareMesh(const PolygonMesh& input, TriangleMesh& output, const Va
     {
       for (std::int64_t k = 1; k + 1 < m; ++k)
       {
-        output.Triangles.push_back({ static_cast<int>(ring[0]), static_cast<int>(ring[k]), static_cast<int>(ring[k + 1]) });
+        output.Triangles.push_back(
+          { static_cast<int>(ring[0]), static_cast<int>(ring[k]), static_cast<int>(ring[k + 1]) });
       }
     }
   }

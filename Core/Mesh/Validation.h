@@ -22,27 +22,27 @@ namespace sdfcage
 struct MeshDefects
 {
   // fatal for an input (the file cannot be trusted), and for a cage
-  bool Empty = false;                     ///< no triangles after conversion and repair
-  std::int64_t NonFinitePoints = 0;       ///< referenced points with NaN/Inf coordinates
-  std::int64_t InvalidPointIds = 0;       ///< cell references outside the point list
+  bool Empty = false;               ///< no triangles after conversion and repair
+  std::int64_t NonFinitePoints = 0; ///< referenced points with NaN/Inf coordinates
+  std::int64_t InvalidPointIds = 0; ///< cell references outside the point list
   // fatal for a cage (usable()), reported and handled for an input
   std::int64_t UntriangulatedPolygons = 0; ///< polygons that could not be split (always 0 from prepareMesh)
-  std::int64_t BoundaryEdges = 0;         ///< edges with one incident triangle (not closed)
-  std::int64_t NonManifoldEdges = 0;      ///< edges with more than two incident triangles
-  std::int64_t NonManifoldVertices = 0;   ///< vertices whose triangle fan is not one disk
-  std::int64_t DegenerateTriangles = 0;   ///< zero-area triangles left (prepareMesh drops them: 0)
-  std::int64_t InconsistentEdges = 0;     ///< edges used twice in the same direction
+  std::int64_t BoundaryEdges = 0;          ///< edges with one incident triangle (not closed)
+  std::int64_t NonManifoldEdges = 0;       ///< edges with more than two incident triangles
+  std::int64_t NonManifoldVertices = 0;    ///< vertices whose triangle fan is not one disk
+  std::int64_t DegenerateTriangles = 0;    ///< zero-area triangles left (prepareMesh drops them: 0)
+  std::int64_t InconsistentEdges = 0;      ///< edges used twice in the same direction
   // repairs of an input (informative)
-  std::int64_t MergedPoints = 0;          ///< points merged into a coincident one (split seams)
-  double MergeTolerance = 0.0;            ///< the merge distance used (input units)
-  std::int64_t TriangulatedPolygons = 0;  ///< quads/polygons split into triangles
+  std::int64_t MergedPoints = 0;               ///< points merged into a coincident one (split seams)
+  double MergeTolerance = 0.0;                 ///< the merge distance used (input units)
+  std::int64_t TriangulatedPolygons = 0;       ///< quads/polygons split into triangles
   std::int64_t DroppedDegenerateTriangles = 0; ///< zero-area triangles dropped
   std::int64_t DroppedDuplicateTriangles = 0;  ///< repeated triangles (same three points) dropped
-  std::int64_t IgnoredCells = 0;          ///< vertex and line cells (not surfaces)
-  std::int64_t UnreferencedPoints = 0;    ///< points no triangle uses (dropped)
-  int Components = 0;                     ///< connected components (several are allowed)
-  int Genus = 0;                          ///< total genus (valid when closedManifold())
-  bool FlippedOrientation = false;        ///< the closed mesh was inward and was flipped
+  std::int64_t IgnoredCells = 0;               ///< vertex and line cells (not surfaces)
+  std::int64_t UnreferencedPoints = 0;         ///< points no triangle uses (dropped)
+  int Components = 0;                          ///< connected components (several are allowed)
+  int Genus = 0;                               ///< total genus (valid when closedManifold())
+  bool FlippedOrientation = false;             ///< the closed mesh was inward and was flipped
 
   /// Strict: a closed, consistently oriented 2-manifold without degenerate triangles (what an
   /// envelope and a cage must be, and the input of the flood-fill path).
@@ -78,8 +78,8 @@ struct ValidationOptions
 /// drops degenerate and duplicated triangles and unreferenced points, ignores vertex/line cells,
 /// measures closedness, manifoldness and orientation consistency, and flips a closed
 /// inward-oriented mesh. `output` is valid when the returned defects are usableAsInput().
-MeshDefects prepareMesh(const PolygonMesh& input, TriangleMesh& output,
-  const ValidationOptions& options = ValidationOptions());
+MeshDefects prepareMesh(
+  const PolygonMesh& input, TriangleMesh& output, const ValidationOptions& options = ValidationOptions());
 
 /// The same checks on a triangle mesh, without conversion or flipping (used to check envelopes
 /// and cages). Orientation is reported through InconsistentEdges only.

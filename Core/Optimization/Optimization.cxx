@@ -237,7 +237,9 @@ public:
     std::size_t done = 0;
     while (!pending.empty())
     {
-      if (Prog && Prog->update(progressBegin + (progressEnd - progressBegin) * double(done) / double(std::max<std::size_t>(1, total))))
+      if (Prog &&
+        Prog->update(
+          progressBegin + (progressEnd - progressBegin) * double(done) / double(std::max<std::size_t>(1, total))))
         return false;
       batch.clear();
       next.clear();
@@ -272,24 +274,25 @@ public:
       }
       outcomeMoves.assign(batch.size(), 0);
       outcomeRejected.assign(batch.size(), 0);
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, batch.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
-        for (std::size_t i = range.begin(); i != range.end(); ++i)
-        {
-          const int v = batch[i];
-          for (int step = 0; step < steps; ++step)
+      tbb::parallel_for(
+        tbb::blocked_range<std::size_t>(0, batch.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
+          for (std::size_t i = range.begin(); i != range.end(); ++i)
           {
-            const int outcome = descend(v, reach[v]);
-            if (outcome > 0)
-              ++outcomeMoves[i];
-            else
+            const int v = batch[i];
+            for (int step = 0; step < steps; ++step)
             {
-              if (outcome < 0)
-                ++outcomeRejected[i];
-              break;
+              const int outcome = descend(v, reach[v]);
+              if (outcome > 0)
+                ++outcomeMoves[i];
+              else
+              {
+                if (outcome < 0)
+                  ++outcomeRejected[i];
+                break;
+              }
             }
           }
-        }
-      });
+        });
       for (std::size_t i = 0; i < batch.size(); ++i)
       {
         r.Moves += outcomeMoves[i];
@@ -359,9 +362,9 @@ public:
   {
     int V = -1;
     Vec3 P0;
-    std::vector<int> Ring;           ///< triangles around v
+    std::vector<int> Ring;                   ///< triangles around v
     std::vector<std::array<int, 3>> RingIds; ///< rotated so v comes first
-    std::vector<int> CageTris;       ///< other cage triangles within selfδ + d̂ + reach
+    std::vector<int> CageTris;               ///< other cage triangles within selfδ + d̂ + reach
     std::vector<Sphere> CageSpheres;
     /// Lower bounds on the distance at P0 between ring triangle i and cage candidate j (exact
     /// where it could matter, index i * count + j); infinite for pairs sharing a vertex.
@@ -444,8 +447,8 @@ public:
       for (std::size_t i = 0; i < nr; ++i)
       {
         const auto& ids = L.RingIds[i];
-        const bool shares = t[0] == ids[1] || t[0] == ids[2] || t[1] == ids[1] || t[1] == ids[2] ||
-          t[2] == ids[1] || t[2] == ids[2];
+        const bool shares =
+          t[0] == ids[1] || t[0] == ids[2] || t[1] == ids[1] || t[1] == ids[2] || t[2] == ids[1] || t[2] == ids[2];
         d0[i] = lowerBound(i, pts, sf, SelfDelta);
         near = near || d0[i] < cageRadius;
         if (shares)
@@ -505,8 +508,8 @@ public:
 
   /// Barrier primitives of the triangles `tris` of a mesh (triangles, points): every triangle,
   /// every edge and every point once.
-  void primitives(const std::vector<int>& tris, const std::vector<Triangle>& triangles,
-    const std::vector<Vec3>& points, double margin, Primitives& out) const
+  void primitives(const std::vector<int>& tris, const std::vector<Triangle>& triangles, const std::vector<Vec3>& points,
+    double margin, Primitives& out) const
   {
     out.clear();
     Work& w = work();
@@ -572,11 +575,12 @@ public:
         if (!inputFar && Tree.anyCloserThan(f, Delta))
           return false;
       const double volume = (q - L.P0).dot((a - L.P0).cross(b - L.P0));
-      const bool solid = std::abs(volume) > 1e-14 * std::pow(std::max({ moved, (a - L.P0).norm(), (b - L.P0).norm() }), 3);
+      const bool solid =
+        std::abs(volume) > 1e-14 * std::pow(std::max({ moved, (a - L.P0).norm(), (b - L.P0).norm() }), 3);
       auto inside = [&](const Vec3& x) {
         if (!solid)
           return false;
-        const double s0 = (a - x).dot((b - x).cross(q - x)); // opposite P0
+        const double s0 = (a - x).dot((b - x).cross(q - x));    // opposite P0
         const double s1 = (L.P0 - x).dot((b - x).cross(a - x)); // opposite q
         const double s2 = (L.P0 - x).dot((q - x).cross(b - x)); // opposite a
         const double s3 = (L.P0 - x).dot((a - x).cross(q - x)); // opposite b
@@ -627,8 +631,8 @@ public:
 
   /// Adds the barrier of the pairs between the primitives and the ring of v at p to B (and its
   /// gradient with respect to p to gb).
-  void barrierTerms(const Local& L, const Primitives& prims, const Vec3& p, double dh, bool withGradient,
-    double& B, Vec3& gb) const
+  void barrierTerms(
+    const Local& L, const Primitives& prims, const Vec3& p, double dh, bool withGradient, double& B, Vec3& gb) const
   {
     auto add = [&](double d, double margin, const Vec3& dddp) {
       const double gap = d - margin;
@@ -966,8 +970,8 @@ private:
   std::vector<Vec3> P;
   std::vector<Triangle> T;
   std::vector<std::vector<int>> VT;
-  std::vector<Vec3> Lo, Hi; ///< triangle boxes, as filed in the grid
-  CageGrid Grid;            ///< updated between relocation batches and after each flip
+  std::vector<Vec3> Lo, Hi;          ///< triangle boxes, as filed in the grid
+  CageGrid Grid;                     ///< updated between relocation batches and after each flip
   std::vector<Vec3> Representatives; ///< one input point per input component
   mutable tbb::enumerable_thread_specific<Work> Works;
   LocalChangeVeto MoveVeto, FlipVeto; ///< read P, T, Lo, Hi and Grid
@@ -1038,7 +1042,8 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
   std::string why;
   double measured = 0.0;
   const auto tv = std::chrono::steady_clock::now();
-  if (!verifyEnclosure(input, cage, std::numeric_limits<double>::min(), measured, why, nullptr, nullptr, true, &inputTree))
+  if (!verifyEnclosure(
+        input, cage, std::numeric_limits<double>::min(), measured, why, nullptr, nullptr, true, &inputTree))
   {
     r.State = Status::InvalidInput;
     r.Message = "the given cage does not enclose the input without self-intersection: " + why;
@@ -1122,8 +1127,8 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
   return r;
 }
 
-OptimizeResult optimizeCageInInputUnits(const TriangleMesh& cage, const TriangleMesh& input,
-  const OptimizeOptions& options, Progress* progress)
+OptimizeResult optimizeCageInInputUnits(
+  const TriangleMesh& cage, const TriangleMesh& input, const OptimizeOptions& options, Progress* progress)
 {
   OptimizeResult r;
   r.Cage = cage;
@@ -1131,7 +1136,8 @@ OptimizeResult optimizeCageInInputUnits(const TriangleMesh& cage, const Triangle
   const MeshDefects di = prepareMesh(PolygonMesh::fromTriangles(input), in);
   if (!di.usableAsInput()) // any surface (open, soup) can be the input; the cage must be closed
   {
-    r.State = di.Empty && di.NonFinitePoints == 0 && di.InvalidPointIds == 0 ? Status::EmptyInput : Status::InvalidInput;
+    r.State =
+      di.Empty && di.NonFinitePoints == 0 && di.InvalidPointIds == 0 ? Status::EmptyInput : Status::InvalidInput;
     r.Message = "input mesh: " + di.inputErrorMessage();
     return r;
   }

@@ -62,29 +62,30 @@ struct OptimizeOptions
 struct OptimizeResult
 {
   Status State = Status::Failed;
-  std::string Message;              ///< error, cancellation or revert reason (empty when all went well)
-  TriangleMesh Cage;                ///< unit-sphere units (the given cage when reverted or invalid)
-  std::vector<double> DistanceToInput; ///< per cage point, exact, unit-sphere units
-  double EnergyBefore = 0.0;        ///< E_quality of the given cage (no barrier)
-  double EnergyAfter = 0.0;         ///< E_quality of the result
-  double MinimumClearance = 0.0;    ///< measured exact minimum distance to the input
-  double ClearanceUsed = 0.0;       ///< δ actually enforced
-  double MinimumAngleBefore = 0.0;  ///< degrees
-  double MinimumAngleAfter = 0.0;   ///< degrees
-  long long Moves = 0;              ///< accepted descent steps
-  long long RejectedMoves = 0;      ///< descent steps with no acceptable step size, by the reason
-  long long MovesWithoutDescent = 0; ///< ... of their last trial: the energy did not drop,
-  long long MovesCutByCollision = 0; ///< the CCD allowed nothing (or too little to lower it),
-  long long MovesVetoedByShape = 0;  ///< a ring triangle would flip or become a needle,
+  std::string Message;                         ///< error, cancellation or revert reason (empty when all went well)
+  TriangleMesh Cage;                           ///< unit-sphere units (the given cage when reverted or invalid)
+  std::vector<double> DistanceToInput;         ///< per cage point, exact, unit-sphere units
+  double EnergyBefore = 0.0;                   ///< E_quality of the given cage (no barrier)
+  double EnergyAfter = 0.0;                    ///< E_quality of the result
+  double MinimumClearance = 0.0;               ///< measured exact minimum distance to the input
+  double ClearanceUsed = 0.0;                  ///< δ actually enforced
+  double MinimumAngleBefore = 0.0;             ///< degrees
+  double MinimumAngleAfter = 0.0;              ///< degrees
+  long long Moves = 0;                         ///< accepted descent steps
+  long long RejectedMoves = 0;                 ///< descent steps with no acceptable step size, by the reason
+  long long MovesWithoutDescent = 0;           ///< ... of their last trial: the energy did not drop,
+  long long MovesCutByCollision = 0;           ///< the CCD allowed nothing (or too little to lower it),
+  long long MovesVetoedByShape = 0;            ///< a ring triangle would flip or become a needle,
   long long MovesVetoedBySelfIntersection = 0; ///< the static self-intersection test failed
-  long long Batches = 0;            ///< relocation batches (vertices relocated in parallel)
+  long long Batches = 0;                       ///< relocation batches (vertices relocated in parallel)
   long long Flips = 0;
-  long long RejectedFlips = 0;      ///< flips that would lower the energy but break a constraint
-  bool Reverted = false;            ///< the final verification failed: the given cage is returned
+  long long RejectedFlips = 0; ///< flips that would lower the energy but break a constraint
+  bool Reverted = false;       ///< the final verification failed: the given cage is returned
   double Seconds = 0.0;
   double RelocationSeconds = 0.0;
   double FlipSeconds = 0.0;
-  double RelocationAndFlipCpuSeconds = 0.0; ///< processor time of the passes (relocation runs parallel batches, one pass after the other)
+  double RelocationAndFlipCpuSeconds =
+    0.0; ///< processor time of the passes (relocation runs parallel batches, one pass after the other)
   double VerificationSeconds = 0.0;
 };
 
@@ -95,15 +96,14 @@ struct OptimizeResult
 /// [progressBegin, progressEnd] of the whole run; a cancel returns the (verified) cage so far with
 /// State Cancelled.
 OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input, const TriangleTree& inputTree,
-  const OptimizeOptions& options, Progress* progress = nullptr, double progressBegin = 0.0,
-  double progressEnd = 1.0);
+  const OptimizeOptions& options, Progress* progress = nullptr, double progressBegin = 0.0, double progressEnd = 1.0);
 
 /// The same for meshes in the input's own coordinates: normalizes both by the input (as
 /// generateCage does), optimizes, and maps the cage, DistanceToInput and MinimumClearance back to
 /// input units (energies and ClearanceUsed stay in unit-sphere units). Validates both meshes
 /// (closed, manifold, consistently oriented; an inward one is flipped).
-OptimizeResult optimizeCageInInputUnits(const TriangleMesh& cage, const TriangleMesh& input,
-  const OptimizeOptions& options, Progress* progress = nullptr);
+OptimizeResult optimizeCageInInputUnits(
+  const TriangleMesh& cage, const TriangleMesh& input, const OptimizeOptions& options, Progress* progress = nullptr);
 
 /// E_quality of a whole cage (unit-sphere units).
 double cageEnergy(const TriangleMesh& cage, const TriangleTree& inputTree, const OptimizeOptions& options);

@@ -64,7 +64,8 @@ CageResult generateOnce(const PolygonMesh& input, const CageOptions& options, Pr
   result.ValidationSeconds = seconds(start);
   if (!result.Defects.usableAsInput())
   {
-    const bool nothing = result.Defects.Empty && result.Defects.NonFinitePoints == 0 && result.Defects.InvalidPointIds == 0;
+    const bool nothing =
+      result.Defects.Empty && result.Defects.NonFinitePoints == 0 && result.Defects.InvalidPointIds == 0;
     result.State = nothing ? Status::EmptyInput : Status::InvalidInput;
     result.Message = result.Defects.inputErrorMessage();
     return result;
@@ -84,10 +85,10 @@ CageResult generateOnce(const PolygonMesh& input, const CageOptions& options, Pr
   // 3. the verified envelope
   // when the dense envelope is itself the cage, its exact clearance is the one to report
   EnvelopeOptions envelopeOptions = options.Envelope;
-  envelopeOptions.ExactEnvelopeClearance = envelopeOptions.ExactEnvelopeClearance || options.TargetNumberOfVertices <= 0;
-  EnvelopeResult env =
-    buildEnvelope(unit, envelopeOptions, progress, options.TargetNumberOfVertices > 0 ? 0.45 : 1.0,
-      result.Defects.usable() ? 1 : 0);
+  envelopeOptions.ExactEnvelopeClearance =
+    envelopeOptions.ExactEnvelopeClearance || options.TargetNumberOfVertices <= 0;
+  EnvelopeResult env = buildEnvelope(
+    unit, envelopeOptions, progress, options.TargetNumberOfVertices > 0 ? 0.45 : 1.0, result.Defects.usable() ? 1 : 0);
   result.SignUsed = env.SignUsed;
   result.SignReason = env.SignReason;
   result.InputClosed = env.InputClosed;
@@ -173,7 +174,8 @@ CageResult generateOnce(const PolygonMesh& input, const CageOptions& options, Pr
     std::vector<double> dist;
     std::string why;
     double clearance = 0.0;
-    const bool ok = verifyEnclosure(unit, result.Simplification.Cage, so.Clearance, clearance, why, &dist, nullptr, true, &tree);
+    const bool ok =
+      verifyEnclosure(unit, result.Simplification.Cage, so.Clearance, clearance, why, &dist, nullptr, true, &tree);
     result.CageVerificationSeconds = seconds(t1);
     if (!ok)
     {
@@ -213,7 +215,7 @@ CageResult generateOnce(const PolygonMesh& input, const CageOptions& options, Pr
     {
       result.State = Status::Cancelled;
       result.Message = result.Simplification.Cancelled ? "cancelled during simplification; the cage so far is valid"
-                                                        : "cancelled during optimization; the cage so far is valid";
+                                                       : "cancelled during optimization; the cage so far is valid";
       result.TotalSeconds = seconds(start);
       return result;
     }
@@ -272,7 +274,8 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
   }
   if (tried > 0 && !best.TargetReached && best.State == Status::Ok)
   {
-    best.StopReason += "; the envelope was widened " + std::to_string(tried) + " time(s), the cage with the fewest vertices is kept";
+    best.StopReason +=
+      "; the envelope was widened " + std::to_string(tried) + " time(s), the cage with the fewest vertices is kept";
   }
   best.WideningLog = log;
   best.TotalSeconds = seconds(start);

@@ -39,7 +39,7 @@ struct CageOptions
 struct CageResult
 {
   Status State = Status::Failed;
-  std::string Message;              ///< error or cancellation reason (empty when Ok)
+  std::string Message; ///< error or cancellation reason (empty when Ok)
   /// Validation report of the input; Empty until the input is validated (a run that did not
   /// happen has no input: not closed, genus undefined).
   MeshDefects Defects = [] {
@@ -47,25 +47,25 @@ struct CageResult
     none.Empty = true;
     return none;
   }();
-  TriangleMesh Cage;                ///< input coordinates
-  std::vector<double> CageDistanceToInput; ///< per cage point, input units
-  TriangleMesh Envelope;            ///< input coordinates
+  TriangleMesh Cage;                           ///< input coordinates
+  std::vector<double> CageDistanceToInput;     ///< per cage point, input units
+  TriangleMesh Envelope;                       ///< input coordinates
   std::vector<double> EnvelopeDistanceToInput; ///< per envelope point, input units
-  double MinimumClearance = 0.0;    ///< measured, input units
-  double MinimumClearanceRelative = 0.0; ///< measured, unit-sphere units
+  double MinimumClearance = 0.0;               ///< measured, input units
+  double MinimumClearanceRelative = 0.0;       ///< measured, unit-sphere units
   bool EnclosureVerified = false;
   int RemovedPockets = 0;
   int EnvelopeGenus = 0;
   int EnvelopeComponents = 0;
-  double VoxelSizeUsed = 0.0;       ///< unit-sphere units
-  int InputGenus = 0;               ///< -1 where undefined (the input is not closed)
+  double VoxelSizeUsed = 0.0; ///< unit-sphere units
+  int InputGenus = 0;         ///< -1 where undefined (the input is not closed)
   int InputComponents = 0;
-  bool InputClosed = false;         ///< closed, consistently oriented 2-manifold (after repair)
+  bool InputClosed = false;                ///< closed, consistently oriented 2-manifold (after repair)
   SignMode SignUsed = SignMode::FloodFill; ///< how the inside was decided (never Auto)
-  std::string SignReason;           ///< why
-  double WindingSeconds = 0.0;      ///< winding-number sign, part of DistanceFieldSeconds
-  std::size_t NumberOfActivePoints = 0;  ///< input points flagged active (0 when off)
-  std::size_t NumberOfActiveSamples = 0; ///< the active set A on the surface sampling
+  std::string SignReason;                  ///< why
+  double WindingSeconds = 0.0;             ///< winding-number sign, part of DistanceFieldSeconds
+  std::size_t NumberOfActivePoints = 0;    ///< input points flagged active (0 when off)
+  std::size_t NumberOfActiveSamples = 0;   ///< the active set A on the surface sampling
   double ActivePointSeconds = 0.0;
   double AmplificationSeconds = 0.0; ///< phi xi on the grid, part of DistanceFieldSeconds
   /// Non-empty when the envelope (and so the cage) does not have the input's genus and
@@ -75,24 +75,24 @@ struct CageResult
   double DistanceFieldSeconds = 0.0;
   double IsosurfaceSeconds = 0.0;
   double VerificationSeconds = 0.0;
-  int VerticesReached = 0;          ///< cage vertex count
-  bool TargetReached = false;       ///< VerticesReached == TargetNumberOfVertices (or target 0)
-  std::string StopReason;           ///< why simplification stopped early (empty otherwise)
-  SimplifyResult Simplification;    ///< statistics of the simplification
+  int VerticesReached = 0;       ///< cage vertex count
+  bool TargetReached = false;    ///< VerticesReached == TargetNumberOfVertices (or target 0)
+  std::string StopReason;        ///< why simplification stopped early (empty otherwise)
+  SimplifyResult Simplification; ///< statistics of the simplification
   double SimplificationSeconds = 0.0;
   double CageVerificationSeconds = 0.0;
-  OptimizeResult Optimization;      ///< statistics of the optional optimization (its Cage is cleared)
-  bool Optimized = false;           ///< the optimization ran and its result is the cage
+  OptimizeResult Optimization; ///< statistics of the optional optimization (its Cage is cleared)
+  bool Optimized = false;      ///< the optimization ran and its result is the cage
   double OptimizationSeconds = 0.0;
   double TotalSeconds = 0.0;
-  double IsoValueUsed = 0.0;        ///< unit-sphere units: the requested one, or widened (see MaximumEnvelopeWidenings)
-  int EnvelopeWidenings = 0;        ///< envelopes rebuilt with twice the isovalue to reach the target
+  double IsoValueUsed = 0.0; ///< unit-sphere units: the requested one, or widened (see MaximumEnvelopeWidenings)
+  int EnvelopeWidenings = 0; ///< envelopes rebuilt with twice the isovalue to reach the target
   /// This run's envelope has more parts and handles than the target's vertices can carry, and
   /// was not simplified because a wider one is tried next (see MaximumEnvelopeWidenings).
   bool EnvelopeTooComplex = false;
   /// One entry per envelope built when widening: isovalue, parts, genus, vertices reached, time.
   std::string WideningLog;
-  ScalarImage DistanceField;        ///< input coordinates and units, when requested
+  ScalarImage DistanceField;         ///< input coordinates and units, when requested
   ScalarImage ModifiedDistanceField; ///< phi * xi, input units, when requested and active points exist
   Normalization Normalize;
 };
@@ -100,7 +100,6 @@ struct CageResult
 /// A field sampled in unit-sphere units, mapped back to input coordinates and lengths.
 ScalarImage imageToInput(ScalarImage image, const Normalization& n);
 
-CageResult generateCage(const PolygonMesh& input, const CageOptions& options,
-  Progress* progress = nullptr);
+CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Progress* progress = nullptr);
 
 } // namespace sdfcage

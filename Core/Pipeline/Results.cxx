@@ -126,11 +126,15 @@ ResultTable cageResults(const CageResult& r)
   const SimplifyResult& s = r.Simplification;
   ResultTable t = {
     // the verdict
-    flag("EnclosureVerified", r.EnclosureVerified, "the cage strictly encloses the input with the clearance (verified)"),
-    real("MeasuredClearance", r.MinimumClearance, "input units", "minimum distance between the cage and the input (exact)"),
-    real("MeasuredClearanceRelative", r.MinimumClearanceRelative, "relative", "the same, for the input scaled into the unit sphere"),
+    flag(
+      "EnclosureVerified", r.EnclosureVerified, "the cage strictly encloses the input with the clearance (verified)"),
+    real("MeasuredClearance", r.MinimumClearance, "input units",
+      "minimum distance between the cage and the input (exact)"),
+    real("MeasuredClearanceRelative", r.MinimumClearanceRelative, "relative",
+      "the same, for the input scaled into the unit sphere"),
     integer("VerticesReached", r.VerticesReached, "count", "vertices of the cage"),
-    flag("TargetReached", r.TargetReached, "the cage has the number of vertices asked for (or no simplification was asked)"),
+    flag("TargetReached", r.TargetReached,
+      "the cage has the number of vertices asked for (or no simplification was asked)"),
     text("StopReason", r.StopReason, "why the simplification stopped before the target (empty when it reached it)"),
     // the envelope (paper 3.1)
     integer("RemovedPockets", r.RemovedPockets, "count", "trapped air pockets (inner envelope components) removed"),
@@ -138,13 +142,17 @@ ResultTable cageResults(const CageResult& r)
     integer("EnvelopeComponents", r.EnvelopeComponents, "count", "connected parts of the envelope"),
     real("VoxelSizeUsed", r.VoxelSizeUsed, "relative", "voxel size of the distance grid, after any refinement"),
     flag("InputWasFlipped", d.FlippedOrientation, "the input was inward-oriented and was flipped"),
-    integer("NumberOfActivePoints", static_cast<long long>(r.NumberOfActivePoints), "count", "input points found active (nearly touching another part)"),
-    integer("NumberOfActiveSamples", static_cast<long long>(r.NumberOfActiveSamples), "count", "samples of the active set A on the surface"),
+    integer("NumberOfActivePoints", static_cast<long long>(r.NumberOfActivePoints), "count",
+      "input points found active (nearly touching another part)"),
+    integer("NumberOfActiveSamples", static_cast<long long>(r.NumberOfActiveSamples), "count",
+      "samples of the active set A on the surface"),
     text("TopologyWarning", r.TopologyWarning, "set when the envelope's genus or components differ from the input's"),
     // the simplification (paper 3.2)
     integer("Collapses", s.Collapses, "count", "edge collapses performed"),
-    integer("CollapsesRejectedByClearance", s.RejectedInput, "count", "candidate collapses vetoed by the clearance to the input"),
-    integer("CollapsesRejectedBySelfIntersection", s.RejectedSelf, "count", "... by a self-intersection or the self clearance"),
+    integer("CollapsesRejectedByClearance", s.RejectedInput, "count",
+      "candidate collapses vetoed by the clearance to the input"),
+    integer("CollapsesRejectedBySelfIntersection", s.RejectedSelf, "count",
+      "... by a self-intersection or the self clearance"),
     integer("CollapsesRejectedByTopology", s.RejectedTopology, "count", "... by the link condition"),
     integer("CollapsesRejectedByShape", s.RejectedShape, "count", "... by a flip or a needle"),
     integer("RelocatedPlacements", s.Relocated, "count", "infeasible placements replaced by a feasible one"),
@@ -152,58 +160,71 @@ ResultTable cageResults(const CageResult& r)
     flag("Optimized", r.Optimized, "the optimization ran and its result is the cage"),
   };
   append(t, optimizationStatistics(r.Optimization));
-  append(t, {
-    // timings
-    real("ValidationTime", r.ValidationSeconds, "s", "input validation and repair"),
-    real("DistanceFieldTime", r.DistanceFieldSeconds, "s", "distance field (sign and amplification included)"),
-    real("ActivePointTime", r.ActivePointSeconds, "s", "active points and their geodesic distances"),
-    real("AmplificationTime", r.AmplificationSeconds, "s", "amplified field phi xi on the grid (part of DistanceFieldTime)"),
-    real("IsosurfaceTime", r.IsosurfaceSeconds, "s", "isosurface extraction"),
-    real("VerificationTime", r.VerificationSeconds, "s", "envelope verification"),
-    real("SimplificationTime", r.SimplificationSeconds, "s", "constrained simplification"),
-    real("CageVerificationTime", r.CageVerificationSeconds, "s", "independent verification of the cage"),
-    real("TotalTime", r.TotalSeconds, "s", "the whole run"),
-    // what was done to the input, and how its inside was decided
-    integer("MergedPoints", d.MergedPoints, "count", "coincident input points merged (split seams, duplicated positions)"),
-    real("MergeTolerance", d.MergeTolerance, "input units", "distance under which points were merged"),
-    integer("TriangulatedPolygons", d.TriangulatedPolygons, "count", "input polygons with more than 3 points split into triangles"),
-    integer("DroppedDegenerateTriangles", d.DroppedDegenerateTriangles, "count", "zero-area triangles dropped"),
-    integer("DroppedDuplicateTriangles", d.DroppedDuplicateTriangles, "count", "repeated triangles dropped"),
-    integer("IgnoredCells", d.IgnoredCells, "count", "vertex and line cells ignored"),
-    integer("InputBoundaryEdges", d.BoundaryEdges, "count", "edges of one triangle (holes, open borders)"),
-    integer("InputNonManifoldEdges", d.NonManifoldEdges, "count", "edges of more than two triangles"),
-    integer("InputNonManifoldVertices", d.NonManifoldVertices, "count", "vertices whose triangles form several fans"),
-    integer("InputInconsistentEdges", d.InconsistentEdges, "count", "edges used twice in the same direction"),
-    integer("InputComponents", d.Components, "count", "connected parts of the input"),
-    integer("InputClosed", d.usable() ? 1 : 0, "", "1: a closed, consistently oriented 2-manifold"),
-    integer("InputGenus", d.usable() ? d.Genus : -1, "", "genus of the input (-1: undefined, the input is not closed)"),
-    text("SignMode", r.SignReason.empty() ? std::string() : std::string(signModeName(r.SignUsed)),
-      "the inside rule used: flood, winding or unsigned (empty when not decided)"),
-    text("SignReason", r.SignReason, "why that rule"),
-    real("WindingTime", r.WindingSeconds, "s", "winding-number sign (part of DistanceFieldTime)"),
-    real("IsoValueUsed", r.IsoValueUsed, "relative", "isovalue of the envelope the cage comes from (unit-sphere units)"),
-    integer("EnvelopeWidenings", r.EnvelopeWidenings, "count", "envelopes rebuilt with twice the isovalue to reach the target (inputs without a defined topology only)"),
-    text("WideningLog", r.WideningLog, "each envelope tried when widening: isovalue, parts, genus, vertices reached, time"),
-  });
+  append(t,
+    {
+      // timings
+      real("ValidationTime", r.ValidationSeconds, "s", "input validation and repair"),
+      real("DistanceFieldTime", r.DistanceFieldSeconds, "s", "distance field (sign and amplification included)"),
+      real("ActivePointTime", r.ActivePointSeconds, "s", "active points and their geodesic distances"),
+      real("AmplificationTime", r.AmplificationSeconds, "s",
+        "amplified field phi xi on the grid (part of DistanceFieldTime)"),
+      real("IsosurfaceTime", r.IsosurfaceSeconds, "s", "isosurface extraction"),
+      real("VerificationTime", r.VerificationSeconds, "s", "envelope verification"),
+      real("SimplificationTime", r.SimplificationSeconds, "s", "constrained simplification"),
+      real("CageVerificationTime", r.CageVerificationSeconds, "s", "independent verification of the cage"),
+      real("TotalTime", r.TotalSeconds, "s", "the whole run"),
+      // what was done to the input, and how its inside was decided
+      integer(
+        "MergedPoints", d.MergedPoints, "count", "coincident input points merged (split seams, duplicated positions)"),
+      real("MergeTolerance", d.MergeTolerance, "input units", "distance under which points were merged"),
+      integer("TriangulatedPolygons", d.TriangulatedPolygons, "count",
+        "input polygons with more than 3 points split into triangles"),
+      integer("DroppedDegenerateTriangles", d.DroppedDegenerateTriangles, "count", "zero-area triangles dropped"),
+      integer("DroppedDuplicateTriangles", d.DroppedDuplicateTriangles, "count", "repeated triangles dropped"),
+      integer("IgnoredCells", d.IgnoredCells, "count", "vertex and line cells ignored"),
+      integer("InputBoundaryEdges", d.BoundaryEdges, "count", "edges of one triangle (holes, open borders)"),
+      integer("InputNonManifoldEdges", d.NonManifoldEdges, "count", "edges of more than two triangles"),
+      integer("InputNonManifoldVertices", d.NonManifoldVertices, "count", "vertices whose triangles form several fans"),
+      integer("InputInconsistentEdges", d.InconsistentEdges, "count", "edges used twice in the same direction"),
+      integer("InputComponents", d.Components, "count", "connected parts of the input"),
+      integer("InputClosed", d.usable() ? 1 : 0, "", "1: a closed, consistently oriented 2-manifold"),
+      integer(
+        "InputGenus", d.usable() ? d.Genus : -1, "", "genus of the input (-1: undefined, the input is not closed)"),
+      text("SignMode", r.SignReason.empty() ? std::string() : std::string(signModeName(r.SignUsed)),
+        "the inside rule used: flood, winding or unsigned (empty when not decided)"),
+      text("SignReason", r.SignReason, "why that rule"),
+      real("WindingTime", r.WindingSeconds, "s", "winding-number sign (part of DistanceFieldTime)"),
+      real(
+        "IsoValueUsed", r.IsoValueUsed, "relative", "isovalue of the envelope the cage comes from (unit-sphere units)"),
+      integer("EnvelopeWidenings", r.EnvelopeWidenings, "count",
+        "envelopes rebuilt with twice the isovalue to reach the target (inputs without a defined topology only)"),
+      text("WideningLog", r.WideningLog,
+        "each envelope tried when widening: isovalue, parts, genus, vertices reached, time"),
+    });
   return t;
 }
 
 ResultTable optimizeResults(const OptimizeResult& o, double measuredClearanceRelative)
 {
   ResultTable t = optimizationStatistics(o);
-  append(t, {
-    real("MeasuredClearance", o.MinimumClearance, "input units", "minimum distance between the optimized cage and the input (exact)"),
-    real("MeasuredClearanceRelative", measuredClearanceRelative, "relative", "the same, for the input scaled into the unit sphere"),
-    real("ClearanceUsed", o.ClearanceUsed, "relative", "the clearance enforced"),
-  });
+  append(t,
+    {
+      real("MeasuredClearance", o.MinimumClearance, "input units",
+        "minimum distance between the optimized cage and the input (exact)"),
+      real("MeasuredClearanceRelative", measuredClearanceRelative, "relative",
+        "the same, for the input scaled into the unit sphere"),
+      real("ClearanceUsed", o.ClearanceUsed, "relative", "the clearance enforced"),
+    });
   return t;
 }
 
 ResultTable activePointResults(const ActivePointAnalysis& a)
 {
   return {
-    integer("NumberOfActivePoints", static_cast<long long>(a.NumberOfActivePoints), "count", "input points found active (nearly touching another part)"),
-    integer("NumberOfActiveSamples", static_cast<long long>(a.NumberOfActiveSamples), "count", "samples of the active set A on the surface"),
+    integer("NumberOfActivePoints", static_cast<long long>(a.NumberOfActivePoints), "count",
+      "input points found active (nearly touching another part)"),
+    integer("NumberOfActiveSamples", static_cast<long long>(a.NumberOfActiveSamples), "count",
+      "samples of the active set A on the surface"),
     integer("NumberOfSamples", static_cast<long long>(a.NumberOfSamples), "count", "samples of the surface"),
     real("ActivePointTime", a.Seconds, "s", "the whole analysis"),
   };
@@ -214,16 +235,26 @@ ResultTable qualityResults(const CageQualityResult& q)
   const double diagonal = q.Diagonal > 0 ? q.Diagonal : 1.0;
   return {
     flag("Encloses", q.Encloses, "the cage strictly encloses the input"),
-    real("MinimumClearance", q.MinimumClearance, "input units", "exact minimum distance between the surfaces (0 if they touch)"),
-    real("MinimumClearanceRelative", q.MinimumClearance / diagonal, "diagonal", "the same, as a fraction of the input's bounding-box diagonal"),
-    real("HausdorffCageToInput", q.HausdorffCageToInput, "input units", "largest distance from the cage surface to the input (value reached)"),
-    real("HausdorffCageToInputRelative", q.HausdorffCageToInput / diagonal, "diagonal", "the same, as a fraction of the diagonal"),
-    real("HausdorffCageToInputBound", q.HausdorffCageToInputBound, "input units", "certified upper bound of HausdorffCageToInput"),
-    real("HausdorffInputToCage", q.HausdorffInputToCage, "input units", "largest distance from the input surface to the cage (value reached)"),
-    real("HausdorffInputToCageRelative", q.HausdorffInputToCage / diagonal, "diagonal", "the same, as a fraction of the diagonal"),
-    real("HausdorffInputToCageBound", q.HausdorffInputToCageBound, "input units", "certified upper bound of HausdorffInputToCage"),
-    real("MeanDistanceCageToInput", q.MeanDistanceCageToInput, "input units", "area-weighted mean distance from the cage surface to the input"),
-    real("MeanDistanceCageToInputRelative", q.MeanDistanceCageToInput / diagonal, "diagonal", "the same, as a fraction of the diagonal"),
+    real("MinimumClearance", q.MinimumClearance, "input units",
+      "exact minimum distance between the surfaces (0 if they touch)"),
+    real("MinimumClearanceRelative", q.MinimumClearance / diagonal, "diagonal",
+      "the same, as a fraction of the input's bounding-box diagonal"),
+    real("HausdorffCageToInput", q.HausdorffCageToInput, "input units",
+      "largest distance from the cage surface to the input (value reached)"),
+    real("HausdorffCageToInputRelative", q.HausdorffCageToInput / diagonal, "diagonal",
+      "the same, as a fraction of the diagonal"),
+    real("HausdorffCageToInputBound", q.HausdorffCageToInputBound, "input units",
+      "certified upper bound of HausdorffCageToInput"),
+    real("HausdorffInputToCage", q.HausdorffInputToCage, "input units",
+      "largest distance from the input surface to the cage (value reached)"),
+    real("HausdorffInputToCageRelative", q.HausdorffInputToCage / diagonal, "diagonal",
+      "the same, as a fraction of the diagonal"),
+    real("HausdorffInputToCageBound", q.HausdorffInputToCageBound, "input units",
+      "certified upper bound of HausdorffInputToCage"),
+    real("MeanDistanceCageToInput", q.MeanDistanceCageToInput, "input units",
+      "area-weighted mean distance from the cage surface to the input"),
+    real("MeanDistanceCageToInputRelative", q.MeanDistanceCageToInput / diagonal, "diagonal",
+      "the same, as a fraction of the diagonal"),
     integer("SelfIntersections", q.SelfIntersections, "count", "intersecting pairs of non-adjacent cage triangles"),
     integer("InputIntersections", q.InputIntersections, "count", "intersecting or touching cage/input triangle pairs"),
     integer("InputVerticesOutside", q.InputVerticesOutside, "count", "input vertices not strictly inside the cage"),

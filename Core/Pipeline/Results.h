@@ -24,7 +24,7 @@ struct ResultField
     Real,
     Text
   };
-  std::string Name;        ///< as in the field data, the getters and the JSON report (CamelCase)
+  std::string Name; ///< as in the field data, the getters and the JSON report (CamelCase)
   Kind Type = Kind::Integer;
   long long Integer = 0;   ///< Flag and Integer
   double Real = 0.0;       ///< Real

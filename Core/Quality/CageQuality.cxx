@@ -71,8 +71,8 @@ std::vector<char> referencedMask(const TriangleMesh& mesh)
 
 /// Distance of every referenced point of `mesh` to the surface in `tree` (NaN for the others),
 /// and the closest triangle of the tree's mesh (-1 for the others).
-std::vector<double> pointDistances(const TriangleMesh& mesh, const std::vector<char>& used, const TriangleTree& tree,
-  std::vector<int>& nearest)
+std::vector<double> pointDistances(
+  const TriangleMesh& mesh, const std::vector<char>& used, const TriangleTree& tree, std::vector<int>& nearest)
 {
   std::vector<double> d(mesh.Points.size(), kNaN);
   nearest.assign(mesh.Points.size(), -1);
@@ -164,7 +164,8 @@ struct Target
     double u = kInf;
     for (int j = 0; j < 3; ++j)
     {
-      const double far = std::max((piece.P[(j + 1) % 3] - piece.P[j]).norm(), (piece.P[(j + 2) % 3] - piece.P[j]).norm());
+      const double far =
+        std::max((piece.P[(j + 1) % 3] - piece.P[j]).norm(), (piece.P[(j + 2) % 3] - piece.P[j]).norm());
       u = std::min(u, piece.D[j] + far);
     }
     for (int j = 0; j < 3; ++j)
@@ -272,59 +273,60 @@ HausdorffBounds hausdorff(const TriangleMesh& from, const std::vector<double>& v
     }
     children.assign(batch.size(), {});
     samples.assign(batch.size(), {});
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, batch.size(), 8), [&](const tbb::blocked_range<std::size_t>& r) {
-      for (std::size_t b = r.begin(); b != r.end(); ++b)
-      {
-        const Piece& piece = batch[b];
-        if (!piece.Refined)
+    tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, batch.size(), 8), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t b = r.begin(); b != r.end(); ++b)
         {
-          const Vec3 c = (piece.P[0] + piece.P[1] + piece.P[2]) / 3.0;
-          int nc = -1;
-          const double dc = to.closest(c, nc);
-          double reach = 0.0;
-          for (const Vec3& p : piece.P)
+          const Piece& piece = batch[b];
+          if (!piece.Refined)
           {
-            reach = std::max(reach, (p - c).norm());
+            const Vec3 c = (piece.P[0] + piece.P[1] + piece.P[2]) / 3.0;
+            int nc = -1;
+            const double dc = to.closest(c, nc);
+            double reach = 0.0;
+            for (const Vec3& p : piece.P)
+            {
+              reach = std::max(reach, (p - c).norm());
+            }
+            Piece refined = piece;
+            refined.Upper = std::min({ piece.Upper, dc + reach, to.convexBound(piece.P, nc) });
+            refined.Refined = true;
+            children[b].push_back(refined);
+            samples[b].push_back(dc);
+            continue;
           }
-          Piece refined = piece;
-          refined.Upper = std::min({ piece.Upper, dc + reach, to.convexBound(piece.P, nc) });
-          refined.Refined = true;
-          children[b].push_back(refined);
-          samples[b].push_back(dc);
-          continue;
-        }
-        Vec3 m[3];
-        double dm[3];
-        int nm[3];
-        for (int k = 0; k < 3; ++k)
-        {
-          m[k] = 0.5 * (piece.P[k] + piece.P[(k + 1) % 3]);
-          dm[k] = to.closest(m[k], nm[k]);
-          samples[b].push_back(dm[k]);
-        }
-        // corners: 0, m0, m2 | m0, 1, m1 | m2, m1, 2 | m0, m1, m2
-        const Vec3* sub[4][3] = { { &piece.P[0], &m[0], &m[2] }, { &m[0], &piece.P[1], &m[1] },
-          { &m[2], &m[1], &piece.P[2] }, { &m[0], &m[1], &m[2] } };
-        const double subD[4][3] = { { piece.D[0], dm[0], dm[2] }, { dm[0], piece.D[1], dm[1] },
-          { dm[2], dm[1], piece.D[2] }, { dm[0], dm[1], dm[2] } };
-        const int subN[4][3] = { { piece.Near[0], nm[0], nm[2] }, { nm[0], piece.Near[1], nm[1] },
-          { nm[2], nm[1], piece.Near[2] }, { nm[0], nm[1], nm[2] } };
-        for (int s = 0; s < 4; ++s)
-        {
-          Piece child;
+          Vec3 m[3];
+          double dm[3];
+          int nm[3];
           for (int k = 0; k < 3; ++k)
           {
-            child.P[k] = *sub[s][k];
-            child.D[k] = subD[s][k];
-            child.Near[k] = subN[s][k];
+            m[k] = 0.5 * (piece.P[k] + piece.P[(k + 1) % 3]);
+            dm[k] = to.closest(m[k], nm[k]);
+            samples[b].push_back(dm[k]);
           }
-          child.Cell = piece.Cell;
-          child.Refined = false;
-          child.Upper = std::min(piece.Upper, to.bound(child));
-          children[b].push_back(child);
+          // corners: 0, m0, m2 | m0, 1, m1 | m2, m1, 2 | m0, m1, m2
+          const Vec3* sub[4][3] = { { &piece.P[0], &m[0], &m[2] }, { &m[0], &piece.P[1], &m[1] },
+            { &m[2], &m[1], &piece.P[2] }, { &m[0], &m[1], &m[2] } };
+          const double subD[4][3] = { { piece.D[0], dm[0], dm[2] }, { dm[0], piece.D[1], dm[1] },
+            { dm[2], dm[1], piece.D[2] }, { dm[0], dm[1], dm[2] } };
+          const int subN[4][3] = { { piece.Near[0], nm[0], nm[2] }, { nm[0], piece.Near[1], nm[1] },
+            { nm[2], nm[1], piece.Near[2] }, { nm[0], nm[1], nm[2] } };
+          for (int s = 0; s < 4; ++s)
+          {
+            Piece child;
+            for (int k = 0; k < 3; ++k)
+            {
+              child.P[k] = *sub[s][k];
+              child.D[k] = subD[s][k];
+              child.Near[k] = subN[s][k];
+            }
+            child.Cell = piece.Cell;
+            child.Refined = false;
+            child.Upper = std::min(piece.Upper, to.bound(child));
+            children[b].push_back(child);
+          }
         }
-      }
-    });
+      });
     // merge in batch order (deterministic whatever the thread count)
     for (std::size_t b = 0; b < batch.size(); ++b)
     {
@@ -401,8 +403,8 @@ namespace
 class CageEvaluation
 {
 public:
-  CageEvaluation(const TriangleMesh& inputMesh, const TriangleMesh& cageMesh, const CageQualityOptions& options,
-    Progress* progress)
+  CageEvaluation(
+    const TriangleMesh& inputMesh, const TriangleMesh& cageMesh, const CageQualityOptions& options, Progress* progress)
     : InputMesh(inputMesh)
     , CageMesh(cageMesh)
     , Options(options)
@@ -521,23 +523,24 @@ private:
     std::vector<std::string>& reasons = this->Reasons;
     if (cage.empty())
     {
-      reasons.push_back(this->CageMesh.Triangles.empty() ? "the cage has no triangles" : "the cage has no valid triangles");
+      reasons.push_back(
+        this->CageMesh.Triangles.empty() ? "the cage has no triangles" : "the cage has no valid triangles");
     }
     if (input.empty())
     {
-      reasons.push_back(
-        this->InputMesh.Triangles.empty() ? "the input mesh has no triangles" : "the input mesh has no valid triangles");
+      reasons.push_back(this->InputMesh.Triangles.empty() ? "the input mesh has no triangles"
+                                                          : "the input mesh has no valid triangles");
     }
     if (r.InvalidTriangles > 0)
     {
-      reasons.push_back(
-        "the cage has " + std::to_string(r.InvalidTriangles) + " triangles with invalid point ids or non-finite points");
+      reasons.push_back("the cage has " + std::to_string(r.InvalidTriangles) +
+        " triangles with invalid point ids or non-finite points");
     }
     if (!cage.empty() && !r.CageClosedManifold)
     {
-      reasons.push_back("the cage is not a closed 2-manifold (" + std::to_string(r.BoundaryEdges) + " boundary edges, " +
-        std::to_string(r.NonManifoldEdges) + " non-manifold edges, " + std::to_string(r.NonManifoldVertices) +
-        " non-manifold vertices)");
+      reasons.push_back("the cage is not a closed 2-manifold (" + std::to_string(r.BoundaryEdges) +
+        " boundary edges, " + std::to_string(r.NonManifoldEdges) + " non-manifold edges, " +
+        std::to_string(r.NonManifoldVertices) + " non-manifold vertices)");
     }
     if (r.InconsistentEdges > 0)
     {
@@ -563,7 +566,8 @@ private:
       r.SelfIntersections = countSelfIntersections(this->Cage, this->Report, this->Touching) + r.DegenerateTriangles;
       if (r.SelfIntersections > 0)
       {
-        this->Reasons.push_back("the cage intersects itself (" + std::to_string(r.SelfIntersections) + " triangle pairs)");
+        this->Reasons.push_back(
+          "the cage intersects itself (" + std::to_string(r.SelfIntersections) + " triangle pairs)");
       }
     }
     if (this->Cage.empty() || this->Input.empty())
@@ -761,18 +765,19 @@ private:
       }
     }
     std::vector<char> inside(input.Points.size(), 0);
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, roots.size(), 1), [&](const tbb::blocked_range<std::size_t>& rg) {
-      for (std::size_t k = rg.begin(); k != rg.end(); ++k)
-      {
-        const int rep = representative[roots[k]];
-        if (inputDistance[rep] <= touching)
+    tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, roots.size(), 1), [&](const tbb::blocked_range<std::size_t>& rg) {
+        for (std::size_t k = rg.begin(); k != rg.end(); ++k)
         {
-          continue; // on the cage: not strictly inside
+          const int rep = representative[roots[k]];
+          if (inputDistance[rep] <= touching)
+          {
+            continue; // on the cage: not strictly inside
+          }
+          const long long w = std::llround(std::abs(windingNumber(this->Cage, input.Points[rep])));
+          inside[roots[k]] = (w % 2) == 1;
         }
-        const long long w = std::llround(std::abs(windingNumber(this->Cage, input.Points[rep])));
-        inside[roots[k]] = (w % 2) == 1;
-      }
-    });
+      });
     for (std::size_t i = 0; i < input.Points.size(); ++i)
     {
       if (this->InputUsed[i] && !(inside[groups.find(static_cast<int>(i))] && inputDistance[i] > touching))
@@ -856,9 +861,9 @@ private:
     CageQualityResult& r = this->R;
     const double tol = this->Options.HausdorffTolerance * r.Diagonal;
     progressStage(this->Report, "Hausdorff cage to input", 0.8, 0.9);
-    const HausdorffBounds hc = hausdorff(this->Cage, this->CageDistance, this->CageNear,
-      Target{ this->InputTree, this->Input }, this->SampledMaximum, tol, this->Options.HausdorffBudget,
-      &this->CellMaximum, this->Report);
+    const HausdorffBounds hc =
+      hausdorff(this->Cage, this->CageDistance, this->CageNear, Target{ this->InputTree, this->Input },
+        this->SampledMaximum, tol, this->Options.HausdorffBudget, &this->CellMaximum, this->Report);
     r.HausdorffCageToInput = hc.Value;
     r.HausdorffCageToInputBound = hc.Bound;
     for (std::size_t f = 0; f < this->CellMaximum.size(); ++f)
@@ -909,12 +914,12 @@ private:
   tbb::task_group InputTopology;
 
   // checkTopologyAndShape
-  TriangleMesh Input, Cage;          ///< the valid triangles (points copied as they are)
+  TriangleMesh Input, Cage;             ///< the valid triangles (points copied as they are)
   std::vector<int> InputKept, CageKept; ///< original index of each valid triangle
-  std::vector<char> InputUsed;       ///< input points referenced by a valid triangle
+  std::vector<char> InputUsed;          ///< input points referenced by a valid triangle
   TriangleTree InputTree, CageTree;
-  double Touching = 0.0;             ///< distances up to this count as touching
-  bool InsideDefined = false;        ///< the cage is closed, consistently oriented, not degenerate
+  double Touching = 0.0;      ///< distances up to this count as touching
+  bool InsideDefined = false; ///< the cage is closed, consistently oriented, not degenerate
   // measurePointDistances
   std::vector<char> CageUsed;
   std::vector<double> CageDistance, InputDistance; ///< per referenced point, to the other surface
@@ -923,13 +928,13 @@ private:
   // measureClearance
   std::vector<double> CellLowerBound; ///< per valid cage triangle, of its distance to the input
   // measureMeanDistance
-  std::vector<double> CellMaximum;    ///< per valid cage triangle, the largest distance sampled
+  std::vector<double> CellMaximum; ///< per valid cage triangle, the largest distance sampled
   double SampledMaximum = 0.0;
 };
 } // namespace
 
-CageQualityResult evaluateCage(const TriangleMesh& inputMesh, const TriangleMesh& cageMesh,
-  const CageQualityOptions& options, Progress* progress)
+CageQualityResult evaluateCage(
+  const TriangleMesh& inputMesh, const TriangleMesh& cageMesh, const CageQualityOptions& options, Progress* progress)
 {
   return CageEvaluation(inputMesh, cageMesh, options, progress).run();
 }

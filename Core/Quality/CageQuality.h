@@ -70,7 +70,7 @@ struct CageQualityResult
   std::string Message;
 
   // --- per cage point / cell (sizes: cage points, cage triangles) ---
-  std::vector<double> PointDistance;  ///< exact distance of each cage point to the input
+  std::vector<double> PointDistance; ///< exact distance of each cage point to the input
   /// Per cage triangle: the largest distance to the input found on it (corners, quadrature
   /// points and branch-and-bound samples): a lower bound of the maximum over the triangle.
   std::vector<double> CellDistance;
@@ -80,15 +80,15 @@ struct CageQualityResult
   std::vector<double> CellMIPSEnergy;
 
   // --- distances ---
-  double Diagonal = 0.0;                 ///< input bounding-box diagonal
-  double MinimumClearance = 0.0;         ///< exact min distance between the surfaces (0 if they touch)
-  double HausdorffCageToInput = 0.0;     ///< max over the cage surface of the distance to the input (value reached)
+  double Diagonal = 0.0;                  ///< input bounding-box diagonal
+  double MinimumClearance = 0.0;          ///< exact min distance between the surfaces (0 if they touch)
+  double HausdorffCageToInput = 0.0;      ///< max over the cage surface of the distance to the input (value reached)
   double HausdorffCageToInputBound = 0.0; ///< certified upper bound of it
-  double HausdorffInputToCage = 0.0;     ///< max over the input surface of the distance to the cage (value reached)
+  double HausdorffInputToCage = 0.0;      ///< max over the input surface of the distance to the cage (value reached)
   double HausdorffInputToCageBound = 0.0; ///< certified upper bound of it
-  double MeanDistanceCageToInput = 0.0;  ///< area-weighted mean over the cage surface (quadrature)
-  double MaximumPointDistance = 0.0;     ///< max of PointDistance
-  double MeanPointDistance = 0.0;        ///< mean of PointDistance
+  double MeanDistanceCageToInput = 0.0;   ///< area-weighted mean over the cage surface (quadrature)
+  double MaximumPointDistance = 0.0;      ///< max of PointDistance
+  double MeanPointDistance = 0.0;         ///< mean of PointDistance
 
   // --- counts ---
   long long SelfIntersections = 0;  ///< intersecting non-adjacent cage triangle pairs (+1 per degenerate triangle)
@@ -97,10 +97,10 @@ struct CageQualityResult
   /// not a closed 2-manifold, is inconsistently oriented or has degenerate triangles) every input
   /// vertex counts as outside.
   long long InputVerticesOutside = 0;
-  long long InputVertices = 0;      ///< referenced input vertices
+  long long InputVertices = 0; ///< referenced input vertices
 
   // --- cage defects (Validation.h terms) ---
-  long long InvalidTriangles = 0;   ///< ids out of range or non-finite points (ignored otherwise)
+  long long InvalidTriangles = 0; ///< ids out of range or non-finite points (ignored otherwise)
   long long BoundaryEdges = 0;
   long long NonManifoldEdges = 0;
   long long NonManifoldVertices = 0;
@@ -117,8 +117,8 @@ struct CageQualityResult
   double Seconds = 0.0;
   /// Wall time of each phase, indexed by CageQualityPhase (phaseSeconds()); named by PhaseNames.
   double PhaseSeconds[7] = { 0, 0, 0, 0, 0, 0, 0 };
-  static constexpr const char* PhaseNames[7] = { "topology", "self-intersections", "point distances",
-    "clearance", "inside test", "mean distance", "Hausdorff" };
+  static constexpr const char* PhaseNames[7] = { "topology", "self-intersections", "point distances", "clearance",
+    "inside test", "mean distance", "Hausdorff" };
   double phaseSeconds(CageQualityPhase phase) const { return PhaseSeconds[static_cast<int>(phase)]; }
 };
 

@@ -89,8 +89,8 @@ bool LocalChangeVeto::shapeOk(std::vector<ChangedTriangle>& tris) const
 {
   for (ChangedTriangle& t : tris)
   {
-    const double floor =
-      Policy.KeepQualityBefore ? std::min(Policy.MinimumTriangleQuality, t.QualityBefore) : Policy.MinimumTriangleQuality;
+    const double floor = Policy.KeepQualityBefore ? std::min(Policy.MinimumTriangleQuality, t.QualityBefore)
+                                                  : Policy.MinimumTriangleQuality;
     if (triangleQuality(t.Pts[0], t.Pts[1], t.Pts[2]) < floor)
       return false;
     t.N = (t.Pts[1] - t.Pts[0]).cross(t.Pts[2] - t.Pts[0]);
@@ -107,7 +107,8 @@ bool LocalChangeVeto::foldFree(const std::vector<ChangedTriangle>& tris) const
 {
   for (std::size_t i = 0; i < tris.size(); ++i)
     for (std::size_t j = i + 1; j < tris.size(); ++j)
-      if (trianglesConflict(tris[i].Ids, tris[i].Pts, tris[j].Ids, tris[j].Pts, Policy.SelfClearance, Policy.FoldCosine))
+      if (trianglesConflict(
+            tris[i].Ids, tris[i].Pts, tris[j].Ids, tris[j].Pts, Policy.SelfClearance, Policy.FoldCosine))
         return false;
   return true;
 }
@@ -231,7 +232,8 @@ bool LocalChangeVeto::selfIntersectionFree(LocalChangeScratch& s, LocalChangeFin
       // meetBeyondSharedVertex's nearly-coplanar case cannot apply)
       if (shared == 1 &&
         (oneSideImpl(nt.Pts[ka], nt.N, c.Pts[(kb + 1) % 3], c.Pts[(kb + 2) % 3]) ||
-          oneSideImpl(c.Pts[kb], (c.Pts[1] - c.Pts[0]).cross(c.Pts[2] - c.Pts[0]), nt.Pts[(ka + 1) % 3], nt.Pts[(ka + 2) % 3])))
+          oneSideImpl(
+            c.Pts[kb], (c.Pts[1] - c.Pts[0]).cross(c.Pts[2] - c.Pts[0]), nt.Pts[(ka + 1) % 3], nt.Pts[(ka + 2) % 3])))
         continue;
       if (disjoint && c.R < 0)
       {

@@ -62,9 +62,9 @@ long long countSelfIntersections(const TriangleMesh& mesh, Progress* progress, d
     [](long long a, long long b) { return a + b; });
 }
 
-bool verifyEnclosure(const TriangleMesh& input, const TriangleMesh& cage, double clearance,
-  double& measuredClearance, std::string& why, std::vector<double>* pointDistances, Progress* progress,
-  bool exactMinimum, const TriangleTree* inputTree)
+bool verifyEnclosure(const TriangleMesh& input, const TriangleMesh& cage, double clearance, double& measuredClearance,
+  std::string& why, std::vector<double>* pointDistances, Progress* progress, bool exactMinimum,
+  const TriangleTree* inputTree)
 {
   measuredClearance = 0.0;
   why.clear();
@@ -202,8 +202,7 @@ bool verifyEnclosure(const TriangleMesh& input, const TriangleMesh& cage, double
   if (!(measuredClearance >= clearance))
   {
     std::ostringstream s;
-    s << "the surface comes within " << measuredClearance << " of the input (required clearance "
-      << clearance << ")";
+    s << "the surface comes within " << measuredClearance << " of the input (required clearance " << clearance << ")";
     why = s.str();
     return false;
   }

@@ -28,8 +28,8 @@ long long countSelfIntersections(const TriangleMesh& mesh, Progress* progress = 
 /// `measuredClearance` (with exactMinimum; otherwise a certified lower bound >= clearance, much
 /// cheaper on dense surfaces) and per-cage-point exact distances in `pointDistances` (if non-null).
 /// `inputTree`, if given, must index `input` (saves building it).
-bool verifyEnclosure(const TriangleMesh& input, const TriangleMesh& cage, double clearance,
-  double& measuredClearance, std::string& why, std::vector<double>* pointDistances = nullptr,
-  Progress* progress = nullptr, bool exactMinimum = true, const TriangleTree* inputTree = nullptr);
+bool verifyEnclosure(const TriangleMesh& input, const TriangleMesh& cage, double clearance, double& measuredClearance,
+  std::string& why, std::vector<double>* pointDistances = nullptr, Progress* progress = nullptr,
+  bool exactMinimum = true, const TriangleTree* inputTree = nullptr);
 
 } // namespace sdfcage

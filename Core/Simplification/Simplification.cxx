@@ -55,8 +55,8 @@ struct Quadric
   double eval(const Vec3& v) const
   {
     const double x = v.x(), y = v.y(), z = v.z();
-    return A[0] * x * x + 2 * A[1] * x * y + 2 * A[2] * x * z + 2 * A[3] * x + A[4] * y * y +
-      2 * A[5] * y * z + 2 * A[6] * y + A[7] * z * z + 2 * A[8] * z + A[9];
+    return A[0] * x * x + 2 * A[1] * x * y + 2 * A[2] * x * z + 2 * A[3] * x + A[4] * y * y + 2 * A[5] * y * z +
+      2 * A[6] * y + A[7] * z * z + 2 * A[8] * z + A[9];
   }
   bool optimum(Vec3& v) const
   {
@@ -721,7 +721,8 @@ private:
       grow(f);
     for (int f : ev.Removed)
       grow(f);
-    auto first = std::lower_bound(Probes.begin(), Probes.end(), lo.x(), [](const Vec3& a, double x) { return a.x() < x; });
+    auto first =
+      std::lower_bound(Probes.begin(), Probes.end(), lo.x(), [](const Vec3& a, double x) { return a.x() < x; });
     for (auto it = first; it != Probes.end() && it->x() <= hi.x(); ++it)
     {
       const Vec3& x = *it;
@@ -803,8 +804,8 @@ private:
           if (!cached)
           {
             const Vec3 x = s == 0 ? p
-              : s == 3 ? Vec3((pts[0] + pts[1] + pts[2]) / 3.0)
-                       : Vec3(0.5 * (p + pts[s == 1 ? (kp + 1) % 3 : (kp + 2) % 3]));
+              : s == 3            ? Vec3((pts[0] + pts[1] + pts[2]) / 3.0)
+                                  : Vec3(0.5 * (p + pts[s == 1 ? (kp + 1) % 3 : (kp + 2) % 3]));
             Vec3 c;
             int tri;
             double d;

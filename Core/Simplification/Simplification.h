@@ -49,17 +49,17 @@ struct SimplifyOptions
 
 struct SimplifyResult
 {
-  TriangleMesh Cage;          ///< unit-sphere units
+  TriangleMesh Cage; ///< unit-sphere units
   int VerticesReached = 0;
   bool TargetReached = false;
   bool Cancelled = false;
-  std::string StopReason;     ///< why it stopped before the target (empty when reached)
+  std::string StopReason; ///< why it stopped before the target (empty when reached)
   long long Collapses = 0;
-  long long RejectedInput = 0;     ///< candidate collapses vetoed by the input clearance
-  long long RejectedSelf = 0;      ///< ... by self-intersection / self clearance
-  long long RejectedTopology = 0;  ///< ... by the link condition
-  long long RejectedShape = 0;     ///< ... by flips or needles
-  long long Relocated = 0;         ///< infeasible placements replaced by a feasible one
+  long long RejectedInput = 0;    ///< candidate collapses vetoed by the input clearance
+  long long RejectedSelf = 0;     ///< ... by self-intersection / self clearance
+  long long RejectedTopology = 0; ///< ... by the link condition
+  long long RejectedShape = 0;    ///< ... by flips or needles
+  long long Relocated = 0;        ///< infeasible placements replaced by a feasible one
   double Seconds = 0.0;
 };
 
@@ -72,7 +72,6 @@ struct SimplifyResult
 /// them out of the cage. Needed whenever the input has components smaller than the cage's
 /// triangles (soups, scans with debris); the pipeline always passes them.
 SimplifyResult simplifyEnvelope(const TriangleMesh& envelope, const TriangleTree& inputTree,
-  const SimplifyOptions& options, Progress* progress = nullptr,
-  const std::vector<Vec3>* inputProbes = nullptr);
+  const SimplifyOptions& options, Progress* progress = nullptr, const std::vector<Vec3>* inputProbes = nullptr);
 
 } // namespace sdfcage

@@ -185,16 +185,16 @@ bool meetBeyondSharedVertex(const Vec3& a, const Vec3& b, const Vec3& c, const V
   {
     // (nearly) coplanar: they overlap beyond a when the corner angles overlap
     const Vec3 n = n1.normalized();
-    return inCorner(d - a, b - a, c - a, n) || inCorner(e - a, b - a, c - a, n) ||
-      inCorner(b - a, d - a, e - a, n) || inCorner(c - a, d - a, e - a, n);
+    return inCorner(d - a, b - a, c - a, n) || inCorner(e - a, b - a, c - a, n) || inCorner(b - a, d - a, e - a, n) ||
+      inCorner(c - a, d - a, e - a, n);
   }
   // the planes meet in the line a + s u; both triangles contain a piece of it on the same side
   return (inCorner(u, b - a, c - a, n1) && inCorner(u, d - a, e - a, n2)) ||
     (inCorner(-u, b - a, c - a, n1) && inCorner(-u, d - a, e - a, n2));
 }
 
-bool trianglesConflict(const int ia[3], const Vec3 pa[3], const int ib[3], const Vec3 pb[3],
-  double separation, double foldCosine)
+bool trianglesConflict(
+  const int ia[3], const Vec3 pa[3], const int ib[3], const Vec3 pb[3], double separation, double foldCosine)
 {
   int sa[3], sb[3], shared = 0;
   for (int i = 0; i < 3; ++i)

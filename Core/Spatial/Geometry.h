@@ -27,8 +27,8 @@ bool meetBeyondSharedVertex(const Vec3& a, const Vec3& b, const Vec3& c, const V
 /// vertex conflict when they intersect or come closer than `separation`; sharing one vertex, when
 /// they meet anywhere else; sharing an edge, when their normals' cosine is below `foldCosine`
 /// (folded onto each other; -1 + tiny for exact intersection only).
-bool trianglesConflict(const int ia[3], const Vec3 pa[3], const int ib[3], const Vec3 pb[3],
-  double separation, double foldCosine);
+bool trianglesConflict(
+  const int ia[3], const Vec3 pa[3], const int ib[3], const Vec3 pb[3], double separation, double foldCosine);
 
 /// Signed solid angle of triangle (a, b, c) seen from p (Van Oosterom & Strackee, "The solid angle
 /// of a plane triangle", 1983): positive when p lies behind the triangle (opposite its

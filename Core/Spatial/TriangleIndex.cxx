@@ -97,8 +97,8 @@ void TriangleIndex::cellRange(const Vec3& lo, const Vec3& hi, std::array<int, 3>
   }
 }
 
-bool TriangleIndex::closestPoint(const Vec3& p, double maxDistance, Vec3& closest, int& triangle,
-  double& distance) const
+bool TriangleIndex::closestPoint(
+  const Vec3& p, double maxDistance, Vec3& closest, int& triangle, double& distance) const
 {
   triangle = -1;
   if (!Mesh || Mesh->Triangles.empty())

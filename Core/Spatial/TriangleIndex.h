@@ -19,8 +19,7 @@ public:
 
   /// Closest point on the mesh to p among triangles within maxDistance (infinite when <0).
   /// Returns false when nothing lies within maxDistance.
-  bool closestPoint(const Vec3& p, double maxDistance, Vec3& closest, int& triangle,
-    double& distance) const;
+  bool closestPoint(const Vec3& p, double maxDistance, Vec3& closest, int& triangle, double& distance) const;
 
   /// Unsigned distance from p to the mesh (searches outward until found).
   double distance(const Vec3& p) const;

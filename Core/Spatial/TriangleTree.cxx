@@ -71,8 +71,8 @@ void TriangleTree::build(const TriangleMesh& mesh)
   }
 }
 
-void TriangleTree::buildNode(int index, int start, int count, std::vector<BuildItem>& items,
-  const std::vector<Tri3>& tri, int depth)
+void TriangleTree::buildNode(
+  int index, int start, int count, std::vector<BuildItem>& items, const std::vector<Tri3>& tri, int depth)
 {
   Node& node = Nodes[index];
   if (count <= 4 || depth > 60)
@@ -277,7 +277,8 @@ double TriangleTree::triangleQuery(const Vec3 t[3], double limit, bool stopAtFir
       const Tri3& o = Tri[i];
       if (hasPlane)
       {
-        const double s0 = normal.dot(o.P[0]) - offset, s1 = normal.dot(o.P[1]) - offset, s2 = normal.dot(o.P[2]) - offset;
+        const double s0 = normal.dot(o.P[0]) - offset, s1 = normal.dot(o.P[1]) - offset,
+                     s2 = normal.dot(o.P[2]) - offset;
         if (std::min({ s0, s1, s2 }) >= best || std::max({ s0, s1, s2 }) <= -best)
         {
           continue;
@@ -369,37 +370,38 @@ void TriangleTree::prepareWindingNumbers()
   Dipoles.assign(Nodes.size(), Dipole());
   // Nodes are in pre-order (children after their parent): leaves first, then parents from the
   // back. Leaves are independent and computed in parallel.
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, Nodes.size(), 4096), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t i = r.begin(); i != r.end(); ++i)
-    {
-      const Node& node = Nodes[i];
-      if (node.Left >= 0)
+  tbb::parallel_for(
+    tbb::blocked_range<std::size_t>(0, Nodes.size(), 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i)
       {
-        continue;
-      }
-      Dipole& d = Dipoles[i];
-      Vec3 weighted = Vec3::Zero();
-      Vec3 mean = Vec3::Zero();
-      for (int k = node.Start; k < node.Start + node.Count; ++k)
-      {
-        const Vec3* P = Tri[k].P;
-        const Vec3 an = 0.5 * (P[1] - P[0]).cross(P[2] - P[0]);
-        const double a = an.norm();
-        d.AreaNormal += an;
-        d.Area += a;
-        weighted += a * (P[0] + P[1] + P[2]) / 3.0;
-        mean += (P[0] + P[1] + P[2]) / 3.0;
-      }
-      d.Center = d.Area > 0 ? Vec3(weighted / d.Area) : Vec3(mean / std::max(1, node.Count));
-      for (int k = node.Start; k < node.Start + node.Count; ++k)
-      {
-        for (const Vec3& q : Tri[k].P)
+        const Node& node = Nodes[i];
+        if (node.Left >= 0)
         {
-          d.Radius = std::max(d.Radius, (q - d.Center).norm());
+          continue;
+        }
+        Dipole& d = Dipoles[i];
+        Vec3 weighted = Vec3::Zero();
+        Vec3 mean = Vec3::Zero();
+        for (int k = node.Start; k < node.Start + node.Count; ++k)
+        {
+          const Vec3* P = Tri[k].P;
+          const Vec3 an = 0.5 * (P[1] - P[0]).cross(P[2] - P[0]);
+          const double a = an.norm();
+          d.AreaNormal += an;
+          d.Area += a;
+          weighted += a * (P[0] + P[1] + P[2]) / 3.0;
+          mean += (P[0] + P[1] + P[2]) / 3.0;
+        }
+        d.Center = d.Area > 0 ? Vec3(weighted / d.Area) : Vec3(mean / std::max(1, node.Count));
+        for (int k = node.Start; k < node.Start + node.Count; ++k)
+        {
+          for (const Vec3& q : Tri[k].P)
+          {
+            d.Radius = std::max(d.Radius, (q - d.Center).norm());
+          }
         }
       }
-    }
-  });
+    });
   for (std::size_t i = Nodes.size(); i-- > 0;)
   {
     const Node& node = Nodes[i];

@@ -53,9 +53,9 @@ private:
   struct Node
   {
     Vec3 Lo, Hi;
-    int Left = -1;  // child index, or -1 for a leaf
+    int Left = -1; // child index, or -1 for a leaf
     int Right = -1;
-    int Start = 0;  // leaf: range into Tri
+    int Start = 0; // leaf: range into Tri
     int Count = 0;
   };
   struct Tri3
@@ -68,15 +68,15 @@ private:
     Vec3 C; // centroid
     int Id;
   };
-  void buildNode(int index, int start, int count, std::vector<BuildItem>& items, const std::vector<Tri3>& tri,
-    int depth);
+  void buildNode(
+    int index, int start, int count, std::vector<BuildItem>& items, const std::vector<Tri3>& tri, int depth);
   double triangleQuery(const Vec3 t[3], double limit, bool stopAtFirst, std::vector<int>* within = nullptr) const;
   struct Dipole
   {
     Vec3 Center = Vec3::Zero();     // area centroid of the node's triangles
     Vec3 AreaNormal = Vec3::Zero(); // sum of area-weighted normals
     double Area = 0.0;
-    double Radius = 0.0;            // farthest triangle corner from Center
+    double Radius = 0.0; // farthest triangle corner from Center
   };
   std::vector<Node> Nodes;
   std::vector<Dipole> Dipoles;

@@ -160,14 +160,16 @@ int runCheck(const std::string& inputPath, const std::string& cagePath, const st
   const bool encloses = r.number("Encloses") != 0;
   if (!quiet)
   {
-    auto genus = [](double v) { return v < 0 ? std::string("n/a (not a closed 2-manifold)") : std::to_string(static_cast<int>(v)); };
+    auto genus = [](double v) {
+      return v < 0 ? std::string("n/a (not a closed 2-manifold)") : std::to_string(static_cast<int>(v));
+    };
     auto count = [&](const char* name) { return static_cast<long long>(r.number(name)); };
     std::cout << "input       : " << inputPath << ", " << r.InputPoints << " points, " << r.InputTriangles
               << " triangles, genus " << genus(r.number("InputGenus")) << "\n"
               << "cage        : " << cagePath << ", " << r.CagePoints << " points, " << r.CageTriangles
               << " triangles, genus " << genus(r.number("CageGenus")) << "\n"
-              << "clearance   : " << g(r.number("MinimumClearance")) << " (input units) = "
-              << g(r.number("MinimumClearanceRelative")) << " of the input's diagonal\n"
+              << "clearance   : " << g(r.number("MinimumClearance"))
+              << " (input units) = " << g(r.number("MinimumClearanceRelative")) << " of the input's diagonal\n"
               << "Hausdorff   : cage->input " << g(r.number("HausdorffCageToInput")) << " ("
               << g(r.number("HausdorffCageToInputRelative")) << " rel.), input->cage "
               << g(r.number("HausdorffInputToCage")) << " (" << g(r.number("HausdorffInputToCageRelative"))

@@ -66,16 +66,15 @@ const char* supportedExtensions()
 std::string lowerExtension(const std::string& path)
 {
   std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(
+    ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return ext;
 }
 
 bool isSupportedExtension(const std::string& path)
 {
   const std::string ext = lowerExtension(path);
-  return ext == ".off" || ext == ".obj" || ext == ".ply" || ext == ".stl" || ext == ".vtp" ||
-    ext == ".vtk";
+  return ext == ".off" || ext == ".obj" || ext == ".ply" || ext == ".stl" || ext == ".vtp" || ext == ".vtk";
 }
 
 vtkSmartPointer<vtkPolyData> readMesh(const std::string& path, std::string& error)
@@ -197,8 +196,7 @@ bool writeMesh(vtkPolyData* mesh, const std::string& path, std::string& error)
   const std::string ext = lowerExtension(path);
   if (!isSupportedExtension(path))
   {
-    error = "cannot write '" + path + "': unknown extension '" + ext +
-      "' (supported: " + supportedExtensions() + ")";
+    error = "cannot write '" + path + "': unknown extension '" + ext + "' (supported: " + supportedExtensions() + ")";
     return false;
   }
   clearMessages();
@@ -260,8 +258,7 @@ bool writeMesh(vtkPolyData* mesh, const std::string& path, std::string& error)
   if (!ok || errorCode != 0 || !vtkError.empty() || !fs::exists(path, ec))
   {
     error = "cannot write '" + path + "'" +
-      (vtkError.empty() ? std::string(": check that the folder exists and is writable")
-                        : ": " + vtkError);
+      (vtkError.empty() ? std::string(": check that the folder exists and is writable") : ": " + vtkError);
     return false;
   }
   return true;
@@ -290,8 +287,7 @@ vtkSmartPointer<vtkPolyData> builtinShape()
       connectivity->SetValue(3 * static_cast<vtkIdType>(t) + k, shape.Triangles[t][k]);
     }
   }
-  offsets->SetValue(static_cast<vtkIdType>(shape.Triangles.size()),
-    3 * static_cast<vtkIdType>(shape.Triangles.size()));
+  offsets->SetValue(static_cast<vtkIdType>(shape.Triangles.size()), 3 * static_cast<vtkIdType>(shape.Triangles.size()));
   vtkNew<vtkCellArray> triangles;
   triangles->SetData(offsets, connectivity);
 

@@ -70,8 +70,8 @@ std::string MessageCollector::clean(const char* vtkText)
   }
   const std::size_t eol = s.find('\n');
   const std::size_t obj = s.find("): ");
-  if (obj != std::string::npos && (eol == std::string::npos || obj < eol) &&
-    s.find(" (0x") != std::string::npos && s.find(" (0x") < obj)
+  if (obj != std::string::npos && (eol == std::string::npos || obj < eol) && s.find(" (0x") != std::string::npos &&
+    s.find(" (0x") < obj)
   {
     s.erase(0, obj + 3);
   }

@@ -186,8 +186,8 @@ bool writeJsonReport(const RunReport& r, const std::string& path, std::string& e
 
 void printSummary(std::ostream& os, const RunReport& r)
 {
-  os << "input       : " << (r.InputFile == "builtin" ? "built-in shape" : r.InputFile) << ", "
-     << r.InputPoints << " points, " << r.InputTriangles << " triangles";
+  os << "input       : " << (r.InputFile == "builtin" ? "built-in shape" : r.InputFile) << ", " << r.InputPoints
+     << " points, " << r.InputTriangles << " triangles";
   if (r.InputCells != r.InputTriangles)
   {
     os << " (from " << r.InputCells << " polygons)";
@@ -235,7 +235,10 @@ void printSummary(std::ostream& os, const RunReport& r)
     const bool reached = r.flag("TargetReached");
     const std::string stop = r.text("StopReason");
     os << (reached ? " (target " : " (target NOT reached: ") << r.TargetNumberOfVertices
-       << (reached ? std::string(" reached") : stop.empty() ? std::string() : std::string("; ") + stop) << ")";
+       << (reached           ? std::string(" reached")
+              : stop.empty() ? std::string()
+                             : std::string("; ") + stop)
+       << ")";
   }
   else
   {
@@ -258,17 +261,17 @@ void printSummary(std::ostream& os, const RunReport& r)
      << seconds(r.number("DistanceFieldTime")) << ", active points " << seconds(r.number("ActivePointTime"))
      << ", isosurface " << seconds(r.number("IsosurfaceTime")) << ", verification "
      << seconds(r.number("VerificationTime")) << ",\n              simplification "
-     << seconds(r.number("SimplificationTime")) << ", cage verification "
-     << seconds(r.number("CageVerificationTime")) << ", total " << seconds(r.number("TotalTime")) << "\n";
+     << seconds(r.number("SimplificationTime")) << ", cage verification " << seconds(r.number("CageVerificationTime"))
+     << ", total " << seconds(r.number("TotalTime")) << "\n";
   if (r.Optimize != "none")
   {
     os << "optimization: " << r.Optimize << " energy " << number(r.number("EnergyBefore")) << " -> "
        << number(r.number("EnergyAfter")) << ", " << r.NumberOfIterations << " iteration(s), "
        << seconds(r.number("OptimizationTime")) << "\n";
   }
-  os << "clearance   : " << number(r.number("MeasuredClearance")) << " (input units) = "
-     << number(r.number("MeasuredClearanceRelative")) << " relative, required >= " << number(r.MinimumClearanceUsed)
-     << " relative\n";
+  os << "clearance   : " << number(r.number("MeasuredClearance"))
+     << " (input units) = " << number(r.number("MeasuredClearanceRelative"))
+     << " relative, required >= " << number(r.MinimumClearanceUsed) << " relative\n";
   os << "enclosure verified: " << (r.flag("EnclosureVerified") ? "yes" : "no") << "\n";
 }
 

@@ -98,8 +98,8 @@ extern "C" void onAbortWhileRendering(int)
   std::raise(SIGABRT);
 }
 
-bool render(vtkPolyData* input, vtkPolyData* cage, const std::string& title,
-  const std::string& path, std::string& error)
+bool render(
+  vtkPolyData* input, vtkPolyData* cage, const std::string& title, const std::string& path, std::string& error)
 {
   MessageCollector* messages = MessageCollector::SafeDownCast(vtkOutputWindow::GetInstance());
   if (messages)
@@ -159,12 +159,11 @@ bool render(vtkPolyData* input, vtkPolyData* cage, const std::string& title,
         range[1] = range[0] + 1e-12;
       }
     }
-    const double viridis[5][3] = { { 0.267, 0.005, 0.329 }, { 0.231, 0.322, 0.545 },
-      { 0.129, 0.569, 0.549 }, { 0.369, 0.788, 0.384 }, { 0.992, 0.906, 0.145 } };
+    const double viridis[5][3] = { { 0.267, 0.005, 0.329 }, { 0.231, 0.322, 0.545 }, { 0.129, 0.569, 0.549 },
+      { 0.369, 0.788, 0.384 }, { 0.992, 0.906, 0.145 } };
     for (int k = 0; k < 5; ++k)
     {
-      colors->AddRGBPoint(range[0] + (range[1] - range[0]) * k / 4.0, viridis[k][0],
-        viridis[k][1], viridis[k][2]);
+      colors->AddRGBPoint(range[0] + (range[1] - range[0]) * k / 4.0, viridis[k][0], viridis[k][1], viridis[k][2]);
     }
     if (distance)
     {
@@ -250,12 +249,10 @@ bool render(vtkPolyData* input, vtkPolyData* cage, const std::string& title,
   window->Finalize(); // release the OpenGL context while our X connection is still open
 
   std::error_code ec;
-  if (png->GetErrorCode() != 0 || !std::filesystem::exists(path, ec) ||
-    (messages && !messages->errors().empty()))
+  if (png->GetErrorCode() != 0 || !std::filesystem::exists(path, ec) || (messages && !messages->errors().empty()))
   {
     error = "cannot write the screenshot '" + path + "'" +
-      ((messages && !messages->errors().empty()) ? ": " + messages->errors().front()
-                                                 : std::string());
+      ((messages && !messages->errors().empty()) ? ": " + messages->errors().front() : std::string());
     return false;
   }
   return true;
@@ -263,8 +260,8 @@ bool render(vtkPolyData* input, vtkPolyData* cage, const std::string& title,
 
 } // namespace
 
-bool writeScreenshot(vtkPolyData* input, vtkPolyData* cage, const std::string& title,
-  const std::string& path, std::string& error)
+bool writeScreenshot(
+  vtkPolyData* input, vtkPolyData* cage, const std::string& title, const std::string& path, std::string& error)
 {
   if (!displayReachable(error))
   {
@@ -296,8 +293,7 @@ bool canRender(std::string& error)
   return false;
 }
 
-bool writeScreenshot(vtkPolyData*, vtkPolyData*, const std::string&, const std::string&,
-  std::string& error)
+bool writeScreenshot(vtkPolyData*, vtkPolyData*, const std::string&, const std::string&, std::string& error)
 {
   return canRender(error);
 }

@@ -19,7 +19,7 @@ bool canRender(std::string& error);
 /// "DistanceToInput", with a colour bar) under `title`, offscreen, into the PNG `path`.
 /// Needs an X server (run under `xvfb-run -a` on a headless machine): checked first, so a
 /// missing display is an error message, never a crash. Returns false with a reason.
-bool writeScreenshot(vtkPolyData* input, vtkPolyData* cage, const std::string& title,
-  const std::string& path, std::string& error);
+bool writeScreenshot(
+  vtkPolyData* input, vtkPolyData* cage, const std::string& title, const std::string& path, std::string& error);
 
 } // namespace sdfcage_cli

@@ -16,7 +16,7 @@
 #include "CLIReport.h"
 #include "CLIScreenshot.h"
 
-#include "Envelope/Envelope.h" // sdfcage::EnvelopeOptions: what "0 = automatic" resolves to
+#include "Envelope/Envelope.h"      // sdfcage::EnvelopeOptions: what "0 = automatic" resolves to
 #include "Pipeline/CageGenerator.h" // sdfcage::CageResult, for the names of the result table
 
 #include <vtkSDFCageFilter.h>
@@ -136,23 +136,23 @@ struct Options
   double Clearance = 0.0;
   double Adaptivity = -1.0; ///< -1 = the filter's default
   int Vertices = -1;        ///< -1 = the filter's default
-  int Refinements = -1; ///< -1 = the filter's default
+  int Refinements = -1;     ///< -1 = the filter's default
   bool NoActivePoints = false;
   double ActiveRadius = -1.0;      ///< -1 = the filter's default
   double GeodesicThreshold = -1.0; ///< -1 = the filter's default
   double Alpha = -1.0;             ///< -1 = the filter's default
   double Beta = -1.0;              ///< -1 = the filter's default
-  std::string Optimize = "none"; ///< none, mips or spacing
-  std::string Sign = "auto";     ///< auto, flood, winding or unsigned
-  double Spacing = -1.0;         ///< -1 = the filter's default
-  int Iterations = -1;           ///< -1 = the filter's default
+  std::string Optimize = "none";   ///< none, mips or spacing
+  std::string Sign = "auto";       ///< auto, flood, winding or unsigned
+  double Spacing = -1.0;           ///< -1 = the filter's default
+  int Iterations = -1;             ///< -1 = the filter's default
   int Threads = 0;
   bool Quiet = false;
   bool Verbose = false; ///< every result after the summary
   bool Help = false;
   bool Version = false;
-  bool Check = false;      ///< --check INPUT CAGE
-  std::string Cage;        ///< the cage of --check
+  bool Check = false; ///< --check INPUT CAGE
+  std::string Cage;   ///< the cage of --check
 };
 
 /// Thrown for a bad command line; main() prints the message and the usage, exit code 2.
@@ -180,8 +180,8 @@ int parseInt(const std::string& option, const std::string& text, int lo, int hi)
   const long v = std::strtol(text.c_str(), &end, 10);
   if (text.empty() || !end || *end != '\0' || v < lo || v > hi)
   {
-    throw UsageError{ option + " expects an integer in [" + std::to_string(lo) + ", " +
-      std::to_string(hi) + "], got '" + text + "'" };
+    throw UsageError{ option + " expects an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) +
+      "], got '" + text + "'" };
   }
   return static_cast<int>(v);
 }
@@ -401,7 +401,8 @@ void checkSupported(const std::string& file, const char* verb)
 }
 
 /// --check INPUT CAGE: two files, and no option of building a cage.
-void finishCheckOptions(Options& o, const std::vector<std::string>& positionals, const std::vector<std::string>& buildOptions)
+void finishCheckOptions(
+  Options& o, const std::vector<std::string>& positionals, const std::vector<std::string>& buildOptions)
 {
   if (positionals.size() != 2)
   {
@@ -630,7 +631,8 @@ RunReport startReport(const Options& o)
 
 /// --- read: the mesh file, or the built-in shape. Null (with the status in `r`) when the file
 /// cannot be read.
-vtkSmartPointer<vtkPolyData> readInput(const Options& o, RunReport& r, ProgressBar* progress, MessageCollector* messages)
+vtkSmartPointer<vtkPolyData> readInput(
+  const Options& o, RunReport& r, ProgressBar* progress, MessageCollector* messages)
 {
   const Clock::time_point start = Clock::now();
   vtkSmartPointer<vtkPolyData> input;
@@ -939,8 +941,7 @@ int main(int argc, char* argv[])
     if (options.Version)
     {
       std::cout << "sdfcage " << SDFCAGE_VERSION << " (VTK " << vtkVersion::GetVTKVersion()
-                << (renderingAvailable() ? ", with rendering" : ", without rendering")
-                << ")\n";
+                << (renderingAvailable() ? ", with rendering" : ", without rendering") << ")\n";
       return ExitOk;
     }
     if (options.Check)

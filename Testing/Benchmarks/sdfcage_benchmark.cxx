@@ -28,7 +28,8 @@ namespace
 
 void usage()
 {
-  std::printf("usage: sdfcage_benchmark [--builtin] [--vertices N] [--iso C] [--voxel H] [--adaptivity A] [--no-active-points] [--active-radius R] "
+  std::printf("usage: sdfcage_benchmark [--builtin] [--vertices N] [--iso C] [--voxel H] [--adaptivity A] "
+              "[--no-active-points] [--active-radius R] "
               "[--threads N] [FILE|FOLDER ...]\n"
               "  default: every mesh of %s\n",
     SDFCAGE_DATA_DIR);
@@ -88,18 +89,20 @@ int runOne(const std::string& name, const std::string& path, const CageOptions& 
     const double diagonal = (box[1] - box[0]).norm();
     const TriangleTree tree(in);
     const double hausdorff = r.Cage.empty() ? 0.0 : hausdorffCageToInput(r.Cage, tree, diagonal / 500.0) / diagonal;
-    std::printf("| %-24s | %8zu | %5.2f | %6.3f | %zu (%zu) | %6.3f | %6.3f | %6.3f | %6.3f | **%6.3f** | %8zu | %6.3f | %6.3f | **%6.3f** | %5d | %7.5f | %7.5f | %d→%d→%d | %d | %7.0f | %s |\n",
+    std::printf("| %-24s | %8zu | %5.2f | %6.3f | %zu (%zu) | %6.3f | %6.3f | %6.3f | %6.3f | **%6.3f** | %8zu | %6.3f "
+                "| %6.3f | **%6.3f** | %5d | %7.5f | %7.5f | %d→%d→%d | %d | %7.0f | %s |\n",
       name.c_str(), input.numberOfCells(), readSeconds, r.ValidationSeconds, r.NumberOfActivePoints,
-      r.NumberOfActiveSamples, r.ActivePointSeconds + r.AmplificationSeconds, r.DistanceFieldSeconds - r.AmplificationSeconds,
-      r.IsosurfaceSeconds, r.VerificationSeconds, envelopeStage, r.Envelope.Triangles.size(),
-      r.SimplificationSeconds, r.CageVerificationSeconds, r.TotalSeconds, r.VerticesReached,
-      r.MinimumClearanceRelative, hausdorff, r.Defects.Genus, r.EnvelopeGenus, genus(r.Cage),
+      r.NumberOfActiveSamples, r.ActivePointSeconds + r.AmplificationSeconds,
+      r.DistanceFieldSeconds - r.AmplificationSeconds, r.IsosurfaceSeconds, r.VerificationSeconds, envelopeStage,
+      r.Envelope.Triangles.size(), r.SimplificationSeconds, r.CageVerificationSeconds, r.TotalSeconds,
+      r.VerticesReached, r.MinimumClearanceRelative, hausdorff, r.Defects.Genus, r.EnvelopeGenus, genus(r.Cage),
       r.RemovedPockets, peakMB, r.EnclosureVerified ? (r.TargetReached ? "yes" : "yes (target not reached)") : "NO");
   }
   else
   {
     std::string msg = r.Message.substr(0, 90);
-    std::printf("| %-24s | %8zu | %5.2f | %6.3f | — | — | — | — | — | %6.3f | — | — | — | %6.3f | — | — | — | — | — | %7.0f | %s: %s |\n",
+    std::printf("| %-24s | %8zu | %5.2f | %6.3f | — | — | — | — | — | %6.3f | — | — | — | %6.3f | — | — | — | — | — | "
+                "%7.0f | %s: %s |\n",
       name.c_str(), input.numberOfCells(), readSeconds, r.ValidationSeconds, envelopeStage, r.TotalSeconds, peakMB,
       statusName(r.State), msg.c_str());
   }
@@ -173,9 +176,8 @@ int main(int argc, char** argv)
         if (ext == ".off" || ext == ".obj" || ext == ".ply")
           files.push_back(e.path());
       }
-      std::sort(files.begin(), files.end(), [](const fs::path& x, const fs::path& y) {
-        return fs::file_size(x) < fs::file_size(y);
-      });
+      std::sort(files.begin(), files.end(),
+        [](const fs::path& x, const fs::path& y) { return fs::file_size(x) < fs::file_size(y); });
       for (const auto& f : files)
         meshes.emplace_back(f.filename().string(), f.string());
     }
@@ -187,11 +189,13 @@ int main(int argc, char** argv)
       return 2;
     }
   }
-  std::printf("c = %g, voxel = %g, adaptivity = %g, active points %s (r %g), target vertices = %d, threads = %d (0 = all)\n\n",
+  std::printf(
+    "c = %g, voxel = %g, adaptivity = %g, active points %s (r %g), target vertices = %d, threads = %d (0 = all)\n\n",
     options.Envelope.IsoValue, options.Envelope.voxelSize(), options.Envelope.Adaptivity,
     options.Envelope.UseActivePoints ? "on" : "off", options.Envelope.ActivePoints.Radius,
     options.TargetNumberOfVertices, options.NumberOfThreads);
-  std::printf("| mesh | faces | read s | validate s | active pts (samples) | active + φξ s | SDF s | isosurface s | verify s | envelope stage s | "
+  std::printf("| mesh | faces | read s | validate s | active pts (samples) | active + φξ s | SDF s | isosurface s | "
+              "verify s | envelope stage s | "
               "envelope tris | simplify s | cage verify s | total s | cage verts | clearance (unit) | "
               "Hausdorff cage→input (/diag) | genus in→env→cage | pockets | peak MB | verified |\n");
   std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");

@@ -116,8 +116,7 @@ int main(int argc, char** argv)
   std::printf("%s: %zu input triangles, cage %zu vertices / %zu triangles (generated in %.2f s)\n", path.c_str(),
     input.Triangles.size(), unitCage.Points.size(), unitCage.Triangles.size(), cageSeconds);
   std::printf("%-8s | %9s | %9s | %10s | %10s | %8s | %8s | %12s | %12s | %10s | %6s | %s\n", "energy", "reloc s",
-    "flips s", "reloc+flip", "(cpu s)", "verify s", "total s", "E before", "E after", "min angle", "moves",
-    "flips");
+    "flips s", "reloc+flip", "(cpu s)", "verify s", "total s", "E before", "E after", "min angle", "moves", "flips");
   int status = 0;
   for (CageEnergy energy : { CageEnergy::MIPS, CageEnergy::Spacing })
   {
@@ -134,11 +133,11 @@ int main(int argc, char** argv)
       status = 1;
       continue;
     }
-    std::printf("%-8s | %9.3f | %9.3f | %10.3f | %10.3f | %8.3f | %8.3f | %12.6g | %12.6g | %4.1f->%4.1f | %6lld | %lld\n",
+    std::printf(
+      "%-8s | %9.3f | %9.3f | %10.3f | %10.3f | %8.3f | %8.3f | %12.6g | %12.6g | %4.1f->%4.1f | %6lld | %lld\n",
       energyName(energy), r.RelocationSeconds, r.FlipSeconds, r.RelocationSeconds + r.FlipSeconds,
-      r.RelocationAndFlipCpuSeconds,
-      r.VerificationSeconds, r.Seconds, r.EnergyBefore, r.EnergyAfter, r.MinimumAngleBefore, r.MinimumAngleAfter,
-      r.Moves, r.Flips);
+      r.RelocationAndFlipCpuSeconds, r.VerificationSeconds, r.Seconds, r.EnergyBefore, r.EnergyAfter,
+      r.MinimumAngleBefore, r.MinimumAngleAfter, r.Moves, r.Flips);
     std::printf("%-8s   %lld relocation batches (mean %.1f vertices each)\n", "", r.Batches,
       double(unitCage.Points.size() * std::max(1, iterations)) / double(std::max(1LL, r.Batches)));
   }

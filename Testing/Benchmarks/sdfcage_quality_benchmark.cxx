@@ -113,14 +113,16 @@ int main(int argc, char* argv[])
   }
   std::vector<double> sorted = times;
   std::sort(sorted.begin(), sorted.end());
-  std::printf("evaluateCage: best %.3f s, median %.3f s over %d runs\n", sorted.front(), sorted[sorted.size() / 2], repeat);
+  std::printf(
+    "evaluateCage: best %.3f s, median %.3f s over %d runs\n", sorted.front(), sorted[sorted.size() / 2], repeat);
   std::printf("phases of the best run:");
   for (int p = 0; p < 7; ++p)
   {
     std::printf(" %s %.3f s%s", CageQualityResult::PhaseNames[p], best.PhaseSeconds[p], p < 6 ? "," : "\n");
   }
   std::printf("encloses %s; clearance %.6g; Hausdorff cage->input %.6g (bound %.6g), input->cage %.6g (bound %.6g); "
-              "mean %.6g; self-intersections %lld, input intersections %lld, input vertices outside %lld; genus cage %d input %d\n",
+              "mean %.6g; self-intersections %lld, input intersections %lld, input vertices outside %lld; genus cage "
+              "%d input %d\n",
     best.Encloses ? "yes" : "NO", best.MinimumClearance, best.HausdorffCageToInput, best.HausdorffCageToInputBound,
     best.HausdorffInputToCage, best.HausdorffInputToCageBound, best.MeanDistanceCageToInput, best.SelfIntersections,
     best.InputIntersections, best.InputVerticesOutside, best.CageGenus, best.InputGenus);

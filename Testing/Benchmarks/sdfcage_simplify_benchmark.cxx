@@ -57,9 +57,9 @@ int run(const std::string& name, const PolygonMesh& polygons, int vertices, int 
   std::printf("%-28s envelope %7zu triangles -> %5d vertices (target %d%s): best of %d %.3f s, "
               "%.1f us/collapse; collapses %lld, rejected input %lld self %lld topology %lld shape "
               "%lld, relocated %lld\n",
-    name.c_str(), envelope.Triangles.size(), r.VerticesReached, vertices,
-    r.TargetReached ? "" : ", not reached", repeat, best, 1e6 * best / std::max(1LL, r.Collapses),
-    r.Collapses, r.RejectedInput, r.RejectedSelf, r.RejectedTopology, r.RejectedShape, r.Relocated);
+    name.c_str(), envelope.Triangles.size(), r.VerticesReached, vertices, r.TargetReached ? "" : ", not reached",
+    repeat, best, 1e6 * best / std::max(1LL, r.Collapses), r.Collapses, r.RejectedInput, r.RejectedSelf,
+    r.RejectedTopology, r.RejectedShape, r.Relocated);
   std::fflush(stdout);
   return 0;
 }

@@ -30,8 +30,8 @@ double distanceToMesh(const TriangleMesh& mesh, const Vec3& p)
   double best = std::numeric_limits<double>::infinity();
   for (const Triangle& t : mesh.Triangles)
   {
-    best = std::min(best,
-      (p - closestPointOnTriangle(p, mesh.Points[t[0]], mesh.Points[t[1]], mesh.Points[t[2]])).norm());
+    best =
+      std::min(best, (p - closestPointOnTriangle(p, mesh.Points[t[0]], mesh.Points[t[1]], mesh.Points[t[2]])).norm());
   }
   return best;
 }

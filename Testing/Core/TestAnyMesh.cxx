@@ -99,7 +99,8 @@ std::vector<Case> cases()
         cracked.Points = s.Points;
         for (std::size_t f = 0; f < s.Triangles.size(); ++f)
         {
-          const Vec3 c = (s.Points[s.Triangles[f][0]] + s.Points[s.Triangles[f][1]] + s.Points[s.Triangles[f][2]]) / 3.0;
+          const Vec3 c =
+            (s.Points[s.Triangles[f][0]] + s.Points[s.Triangles[f][1]] + s.Points[s.Triangles[f][2]]) / 3.0;
           if (!(std::abs(c.z()) < 0.1 && c.x() > 0.3 && std::abs(c.y()) < 0.5))
             cracked.Triangles.push_back(s.Triangles[f]);
         }
@@ -191,7 +192,8 @@ std::vector<Case> cases()
           {
             const double u = 2 * M_PI * i / nu, v = 2 * M_PI * j / nv;
             const double r = 0.35 * (((i + j) % 2) ? 1.15 : 0.9);
-            m.Points.emplace_back((1 + r * std::cos(v)) * std::cos(u), (1 + r * std::cos(v)) * std::sin(u), r * std::sin(v));
+            m.Points.emplace_back(
+              (1 + r * std::cos(v)) * std::cos(u), (1 + r * std::cos(v)) * std::sin(u), r * std::sin(v));
           }
         for (int i = 0; i < nu; ++i)
           for (int j = 0; j < nv; ++j)

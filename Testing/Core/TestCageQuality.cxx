@@ -119,7 +119,8 @@ void expectAgreesWithExact(const TriangleMesh& input, const TriangleMesh& cage, 
   const exact::ExactReport e = exact::exactCheck(input, cage, 0.0);
   EXPECT_EQ(q.Encloses, e.Encloses) << q.Message << "\nexact: " << exact::toJson(e);
   EXPECT_EQ(q.SelfIntersections > 0, e.SelfIntersections > 0) << q.SelfIntersections << " vs " << e.SelfIntersections;
-  EXPECT_EQ(q.InputIntersections > 0, e.InputIntersections > 0) << q.InputIntersections << " vs " << e.InputIntersections;
+  EXPECT_EQ(q.InputIntersections > 0, e.InputIntersections > 0)
+    << q.InputIntersections << " vs " << e.InputIntersections;
   EXPECT_EQ(q.InputVerticesOutside, e.InputVerticesOutside);
   EXPECT_EQ(q.CageClosedManifold, e.Closed2Manifold);
   if (e.Closed2Manifold)
@@ -169,7 +170,10 @@ TEST(CageQuality, GoodBoxAroundSphere)
     double d = std::numeric_limits<double>::infinity();
     for (const Triangle& o : sphere.Triangles)
     {
-      d = std::min(d, (box.Points[i] - closestPointOnTriangle(box.Points[i], sphere.Points[o[0]], sphere.Points[o[1]], sphere.Points[o[2]])).norm());
+      d = std::min(d,
+        (box.Points[i] -
+          closestPointOnTriangle(box.Points[i], sphere.Points[o[0]], sphere.Points[o[1]], sphere.Points[o[2]]))
+          .norm());
     }
     EXPECT_NEAR(q.PointDistance[i], d, 1e-12);
   }
@@ -375,8 +379,8 @@ TEST(CageQuality, VertexExactlyOnAnInputEdgeTouches)
   Vec3 u = m - Vec3(0.75, 1.0, 0.75);
   u = (u - u.dot(d) * d).normalized();
   auto cageWithApex = [&](const Vec3& apex) {
-    return tetrahedron(apex, apex + 3.0 * u + Vec3(0.3, 0, 0), apex + 3.0 * u + Vec3(0, 0.3, 0),
-      apex + 3.0 * u + Vec3(0, 0, 0.3));
+    return tetrahedron(
+      apex, apex + 3.0 * u + Vec3(0.3, 0, 0), apex + 3.0 * u + Vec3(0, 0.3, 0), apex + 3.0 * u + Vec3(0, 0, 0.3));
   };
   // touching: not enclosing, clearance 0, the touching pairs counted; CGAL agrees
   const TriangleMesh touching = cageWithApex(m);

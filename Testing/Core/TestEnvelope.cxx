@@ -59,22 +59,21 @@ double bruteDistance(const TriangleMesh& mesh, const Vec3& p)
   double best = std::numeric_limits<double>::infinity();
   for (const Triangle& t : mesh.Triangles)
   {
-    best = std::min(best,
-      (p - closestPointOnTriangle(p, mesh.Points[t[0]], mesh.Points[t[1]], mesh.Points[t[2]])).norm());
+    best =
+      std::min(best, (p - closestPointOnTriangle(p, mesh.Points[t[0]], mesh.Points[t[1]], mesh.Points[t[2]])).norm());
   }
   return best;
 }
 
 /// The checks every verified envelope/cage must pass against its input (same coordinates).
 /// `delta`: the promised clearance; `limit`: exact measuring range (> the expected clearance).
-exact::ExactReport expectEncloses(const TriangleMesh& input, const TriangleMesh& cage, double delta,
-  double limit, const std::string& what)
+exact::ExactReport expectEncloses(
+  const TriangleMesh& input, const TriangleMesh& cage, double delta, double limit, const std::string& what)
 {
   const exact::ExactReport r = exact::exactCheck(input, cage, limit);
-  std::cout << "[ exact    ] " << what << ": " << r.CageTriangles << " cage triangles vs "
-            << r.InputTriangles << " input triangles, clearance " << r.MinimumClearance
-            << " (promised " << delta << "), genus " << r.CageGenus << ", components "
-            << r.CageComponents << ", exactCheck " << r.Seconds << " s\n";
+  std::cout << "[ exact    ] " << what << ": " << r.CageTriangles << " cage triangles vs " << r.InputTriangles
+            << " input triangles, clearance " << r.MinimumClearance << " (promised " << delta << "), genus "
+            << r.CageGenus << ", components " << r.CageComponents << ", exactCheck " << r.Seconds << " s\n";
   EXPECT_TRUE(r.Closed2Manifold) << what << ": boundary " << r.BoundaryEdges << ", non-manifold edges "
                                  << r.NonManifoldEdges << ", vertices " << r.NonManifoldVertices;
   EXPECT_EQ(r.SelfIntersections, 0) << what;
@@ -119,25 +118,24 @@ TEST_P(EnvelopeShapes, GenerateCageEnclosesExactly)
   ASSERT_FALSE(result.Envelope.empty());
   ASSERT_FALSE(result.Cage.empty());
   std::cout << "[ timing   ] " << shape.Name << ": total " << result.TotalSeconds << " s (SDF "
-            << result.DistanceFieldSeconds << ", isosurface " << result.IsosurfaceSeconds
-            << ", verification " << result.VerificationSeconds << ", simplification "
-            << result.SimplificationSeconds << ", cage verification "
-            << result.CageVerificationSeconds << "), voxel " << result.VoxelSizeUsed << ", "
+            << result.DistanceFieldSeconds << ", isosurface " << result.IsosurfaceSeconds << ", verification "
+            << result.VerificationSeconds << ", simplification " << result.SimplificationSeconds
+            << ", cage verification " << result.CageVerificationSeconds << "), voxel " << result.VoxelSizeUsed << ", "
             << result.VerticesReached << " cage vertices\n";
 
   const Normalization& n = result.Normalize;
   const double delta = n.lengthToInput(options.Envelope.clearance());
   // The envelope lies near distance c, so 2c measures its clearance exactly; a coarse cage can be
   // farther away, so it gets a quarter of the unit radius.
-  const exact::ExactReport env = expectEncloses(input, result.Envelope, delta,
-    n.lengthToInput(2.0 * options.Envelope.IsoValue), shape.Name + " envelope");
+  const exact::ExactReport env = expectEncloses(
+    input, result.Envelope, delta, n.lengthToInput(2.0 * options.Envelope.IsoValue), shape.Name + " envelope");
   const exact::ExactReport cage =
     expectEncloses(input, result.Cage, delta, n.lengthToInput(0.25), shape.Name + " cage");
 
   // Core's own measurements agree with the independent ones.
   EXPECT_NEAR(result.MinimumClearance, cage.MinimumClearance, 1e-6 * cage.MinimumClearance);
-  EXPECT_NEAR(result.MinimumClearanceRelative, n.lengthToUnit(result.MinimumClearance),
-    1e-9 * result.MinimumClearanceRelative);
+  EXPECT_NEAR(
+    result.MinimumClearanceRelative, n.lengthToUnit(result.MinimumClearance), 1e-9 * result.MinimumClearanceRelative);
   EXPECT_EQ(result.EnvelopeGenus, env.CageGenus);
   EXPECT_EQ(result.EnvelopeComponents, env.CageComponents);
   if (shape.Components >= 0)
@@ -165,8 +163,7 @@ TEST_P(EnvelopeShapes, GenerateCageEnclosesExactly)
   // brute-force distance (spot checks).
   ASSERT_EQ(result.EnvelopeDistanceToInput.size(), result.Envelope.Points.size());
   ASSERT_EQ(result.CageDistanceToInput.size(), result.Cage.Points.size());
-  const double smallest =
-    *std::min_element(result.CageDistanceToInput.begin(), result.CageDistanceToInput.end());
+  const double smallest = *std::min_element(result.CageDistanceToInput.begin(), result.CageDistanceToInput.end());
   EXPECT_GE(smallest, cage.MinimumClearance * (1.0 - 1e-9));
   const std::size_t step = std::max<std::size_t>(1, result.Cage.Points.size() / 40);
   for (std::size_t i = 0; i < result.Cage.Points.size(); i += step)
@@ -214,12 +211,12 @@ TEST(GenerateCage, OtherVertexCounts)
       // Allowed (DESIGN: "if no feasible collapse remains it says so"), but it must say so.
       EXPECT_FALSE(result.StopReason.empty());
       EXPECT_GT(result.VerticesReached, target);
-      std::cout << "[ note     ] target " << target << " not reached: " << result.VerticesReached
-                << " vertices; " << result.StopReason << "\n";
+      std::cout << "[ note     ] target " << target << " not reached: " << result.VerticesReached << " vertices; "
+                << result.StopReason << "\n";
     }
     const Normalization& n = result.Normalize;
-    expectEncloses(input, result.Cage, n.lengthToInput(options.Envelope.clearance()),
-      n.lengthToInput(0.25), "builtin cage, " + std::to_string(target) + " vertices");
+    expectEncloses(input, result.Cage, n.lengthToInput(options.Envelope.clearance()), n.lengthToInput(0.25),
+      "builtin cage, " + std::to_string(target) + " vertices");
   }
 }
 
@@ -233,8 +230,8 @@ TEST_P(EnvelopeShapes, BuildEnvelopeEnclosesExactly)
   const EnvelopeResult env = buildEnvelope(unit, options);
   ASSERT_EQ(env.State, Status::Ok) << statusName(env.State) << ": " << env.Message;
   ASSERT_TRUE(env.EnclosureVerified);
-  const exact::ExactReport r = expectEncloses(unit, env.Envelope, options.clearance(),
-    2.0 * options.IsoValue, shape.Name + " envelope");
+  const exact::ExactReport r =
+    expectEncloses(unit, env.Envelope, options.clearance(), 2.0 * options.IsoValue, shape.Name + " envelope");
   // By default Core certifies a lower bound of the envelope's clearance, at least delta.
   EXPECT_GE(env.MinimumClearance, options.clearance());
   EXPECT_LE(env.MinimumClearance, r.MinimumClearance * (1.0 + 1e-9));
@@ -246,8 +243,7 @@ TEST_P(EnvelopeShapes, BuildEnvelopeEnclosesExactly)
   // The kept field is a dense grid covering the envelope.
   const ScalarImage& f = env.DistanceField;
   ASSERT_GT(f.Dimensions[0] * f.Dimensions[1] * f.Dimensions[2], 0);
-  EXPECT_EQ(f.Values.size(),
-    static_cast<std::size_t>(f.Dimensions[0]) * f.Dimensions[1] * f.Dimensions[2]);
+  EXPECT_EQ(f.Values.size(), static_cast<std::size_t>(f.Dimensions[0]) * f.Dimensions[1] * f.Dimensions[2]);
   EXPECT_GT(f.Spacing, 0.0);
   const auto b = bounds(env.Envelope);
   for (int k = 0; k < 3; ++k)
@@ -271,8 +267,7 @@ TEST(Envelope, LargerIsoValueExplicitAndExactClearance)
   ASSERT_EQ(env.State, Status::Ok) << env.Message;
   ASSERT_TRUE(env.EnclosureVerified);
   EXPECT_DOUBLE_EQ(options.clearance(), 0.015);
-  const exact::ExactReport r =
-    expectEncloses(unit, env.Envelope, 0.015, 2.0 * options.IsoValue, "torus c=0.04");
+  const exact::ExactReport r = expectEncloses(unit, env.Envelope, 0.015, 2.0 * options.IsoValue, "torus c=0.04");
   // Asked for the exact clearance, Core must agree with the independent measurement.
   EXPECT_NEAR(env.MinimumClearance, r.MinimumClearance, 1e-6 * r.MinimumClearance);
   EXPECT_EQ(r.CageGenus, 1);
@@ -335,8 +330,7 @@ protected:
 TEST(Cancel, ImmediatelyGivesCancelled)
 {
   PollingCancel progress(0.0);
-  const CageResult result =
-    generateCage(PolygonMesh::fromTriangles(makeBuiltinShape()), CageOptions(), &progress);
+  const CageResult result = generateCage(PolygonMesh::fromTriangles(makeBuiltinShape()), CageOptions(), &progress);
   EXPECT_EQ(result.State, Status::Cancelled) << statusName(result.State) << ": " << result.Message;
   EXPECT_FALSE(result.EnclosureVerified);
   EXPECT_GT(progress.Polls.load(), 0);
@@ -345,8 +339,7 @@ TEST(Cancel, ImmediatelyGivesCancelled)
 TEST(Cancel, DuringTheDistanceFieldGivesCancelled)
 {
   PollingCancel progress(0.05); // past validation, inside the SDF/isosurface stage
-  const CageResult result =
-    generateCage(PolygonMesh::fromTriangles(makeBuiltinShape()), CageOptions(), &progress);
+  const CageResult result = generateCage(PolygonMesh::fromTriangles(makeBuiltinShape()), CageOptions(), &progress);
   EXPECT_EQ(result.State, Status::Cancelled) << statusName(result.State) << ": " << result.Message;
   EXPECT_FALSE(result.EnclosureVerified);
 }
@@ -365,8 +358,8 @@ TEST(Cancel, FromReportLateInTheRunGivesCancelled)
     {
       // A partial cage handed out after a cancel must still be a valid cage.
       const Normalization& n = result.Normalize;
-      expectEncloses(input, result.Cage, n.lengthToInput(CageOptions().Envelope.clearance()),
-        n.lengthToInput(0.25), "partial cage after cancel at " + std::to_string(at));
+      expectEncloses(input, result.Cage, n.lengthToInput(CageOptions().Envelope.clearance()), n.lengthToInput(0.25),
+        "partial cage after cancel at " + std::to_string(at));
     }
   }
 }
@@ -375,8 +368,7 @@ TEST(Cancel, BuildEnvelopeDirectly)
 {
   const TriangleMesh input = makeSphere(Vec3(0, 0, 0), 1.0, 32, 16);
   PollingCancel progress(0.0);
-  const EnvelopeResult env =
-    buildEnvelope(Normalization::fit(input).toUnit(input), EnvelopeOptions(), &progress);
+  const EnvelopeResult env = buildEnvelope(Normalization::fit(input).toUnit(input), EnvelopeOptions(), &progress);
   EXPECT_EQ(env.State, Status::Cancelled) << statusName(env.State) << ": " << env.Message;
   EXPECT_FALSE(env.EnclosureVerified);
 }

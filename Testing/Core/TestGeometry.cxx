@@ -227,8 +227,7 @@ TEST(Geometry, CoplanarTriangleDistance)
 
   // The same pairs in a tilted plane.
   const Eigen::Matrix3d rotation =
-    (Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()) * Eigen::AngleAxisd(0.3, Vec3::UnitX()))
-      .toRotationMatrix();
+    (Eigen::AngleAxisd(0.7, Vec3(1, 2, 3).normalized()) * Eigen::AngleAxisd(0.3, Vec3::UnitX())).toRotationMatrix();
   Vec3 ra[3], rb[3];
   for (int k = 0; k < 3; ++k)
   {
@@ -308,8 +307,7 @@ double bruteDistance(const TriangleMesh& m, const Vec3& p, int& triangle)
   for (std::size_t t = 0; t < m.Triangles.size(); ++t)
   {
     const Triangle& tri = m.Triangles[t];
-    const double d = (p - closestPointOnTriangle(p, m.Points[tri[0]], m.Points[tri[1]],
-      m.Points[tri[2]])).norm();
+    const double d = (p - closestPointOnTriangle(p, m.Points[tri[0]], m.Points[tri[1]], m.Points[tri[2]])).norm();
     if (d < best)
     {
       best = d;

@@ -40,12 +40,11 @@ void expectGuarantees(const TriangleMesh& input, const TriangleMesh& before, con
   EXPECT_EQ(r.Cage.Triangles.size(), before.Triangles.size()) << what;
   const exact::ExactReport e = exact::exactCheck(input, r.Cage, 4 * deltaInputUnits);
   const exact::ExactReport e0 = exact::exactCheck(input, before, 4 * deltaInputUnits);
-  std::cout << "[ optimize ] " << what << ": energy " << r.EnergyBefore << " -> " << r.EnergyAfter
-            << ", min angle " << r.MinimumAngleBefore << " -> " << r.MinimumAngleAfter << " deg, moves "
-            << r.Moves << " (rejected " << r.RejectedMoves << "), flips " << r.Flips << " (vetoed "
-            << r.RejectedFlips << "), exact clearance " << e.MinimumClearance << " (delta " << deltaInputUnits
-            << "), " << r.Seconds << " s (relocation " << r.RelocationSeconds << " s, flips " << r.FlipSeconds
-            << " s)\n";
+  std::cout << "[ optimize ] " << what << ": energy " << r.EnergyBefore << " -> " << r.EnergyAfter << ", min angle "
+            << r.MinimumAngleBefore << " -> " << r.MinimumAngleAfter << " deg, moves " << r.Moves << " (rejected "
+            << r.RejectedMoves << "), flips " << r.Flips << " (vetoed " << r.RejectedFlips << "), exact clearance "
+            << e.MinimumClearance << " (delta " << deltaInputUnits << "), " << r.Seconds << " s (relocation "
+            << r.RelocationSeconds << " s, flips " << r.FlipSeconds << " s)\n";
   EXPECT_TRUE(e.Closed2Manifold) << what;
   EXPECT_EQ(e.SelfIntersections, 0) << what;
   EXPECT_EQ(e.InputIntersections, 0) << what;
@@ -156,9 +155,9 @@ TEST(Optimization, SpacingConcentratesAroundTarget)
   double m0, s0, m1, s1;
   spacingStatistics(n.toUnit(cage.Cage), tree, h, m0, s0);
   spacingStatistics(n.toUnit(r.Cage), tree, h, m1, s1);
-  std::cout << "[ spacing  ] distance - h over cage samples (h = " << h << ", unit-sphere units): before mean "
-            << m0 << " stddev " << s0 << " rms " << std::hypot(m0, s0) << "; after mean " << m1 << " stddev " << s1
-            << " rms " << std::hypot(m1, s1) << "\n";
+  std::cout << "[ spacing  ] distance - h over cage samples (h = " << h << ", unit-sphere units): before mean " << m0
+            << " stddev " << s0 << " rms " << std::hypot(m0, s0) << "; after mean " << m1 << " stddev " << s1 << " rms "
+            << std::hypot(m1, s1) << "\n";
   EXPECT_LT(std::abs(m1), 0.5 * std::abs(m0));
   EXPECT_LT(std::hypot(m1, s1), 0.5 * std::hypot(m0, s0));
 }
@@ -371,7 +370,8 @@ TEST(Optimization, CancelInsideGenerateCage)
   const CageResult r = generateCage(PolygonMesh::fromTriangles(input), o, &progress);
   EXPECT_EQ(r.State, Status::Cancelled) << r.Message;
   EXPECT_NE(r.Message.find("optimization"), std::string::npos) << r.Message;
-  EXPECT_NE(std::find(progress.Stages.begin(), progress.Stages.end(), "relocating cage vertices"), progress.Stages.end());
+  EXPECT_NE(
+    std::find(progress.Stages.begin(), progress.Stages.end(), "relocating cage vertices"), progress.Stages.end());
   ASSERT_EQ(r.Cage.Points.size(), 300u);
   const exact::ExactReport e = exact::exactCheck(input, r.Cage, r.Normalize.lengthToInput(0.01));
   EXPECT_TRUE(e.Encloses);

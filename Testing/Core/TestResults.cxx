@@ -29,7 +29,8 @@ void expectWellFormed(const ResultTable& table, const char* what)
     EXPECT_TRUE(std::isupper(static_cast<unsigned char>(f.Name[0]))) << what << ": " << f.Name << " is not CamelCase";
     for (const char c : f.Name)
     {
-      EXPECT_TRUE(std::isalnum(static_cast<unsigned char>(c))) << what << ": " << f.Name << " is not a plain identifier";
+      EXPECT_TRUE(std::isalnum(static_cast<unsigned char>(c)))
+        << what << ": " << f.Name << " is not a plain identifier";
     }
     EXPECT_FALSE(f.Description.empty()) << what << ": " << f.Name << " has no description";
     if (f.Type == ResultField::Kind::Text || f.Type == ResultField::Kind::Flag)
@@ -81,22 +82,22 @@ TEST(Results, NamesUsersScriptAgainstArePresent)
 {
   // field-data arrays, getters and JSON keys of the first waves: renaming one breaks scripts
   const ResultTable cage = cageResults(CageResult());
-  for (const char* name : { "ValidationTime", "DistanceFieldTime", "IsosurfaceTime", "VerificationTime",
-         "SimplificationTime", "CageVerificationTime", "TotalTime", "EnergyBefore", "EnergyAfter",
-         "OptimizationTime", "VerticesReached", "TargetReached", "StopReason", "MeasuredClearance",
-         "MeasuredClearanceRelative", "EnclosureVerified", "RemovedPockets", "EnvelopeGenus", "EnvelopeComponents",
-         "VoxelSizeUsed", "InputWasFlipped", "NumberOfActivePoints", "ActivePointTime", "TopologyWarning",
-         "MergedPoints", "MergeTolerance", "TriangulatedPolygons", "DroppedDegenerateTriangles",
-         "DroppedDuplicateTriangles", "IgnoredCells", "InputBoundaryEdges", "InputNonManifoldEdges",
-         "InputNonManifoldVertices", "InputInconsistentEdges", "InputComponents", "InputClosed", "InputGenus",
-         "SignMode", "SignReason", "WindingTime" })
+  for (const char* name :
+    { "ValidationTime", "DistanceFieldTime", "IsosurfaceTime", "VerificationTime", "SimplificationTime",
+      "CageVerificationTime", "TotalTime", "EnergyBefore", "EnergyAfter", "OptimizationTime", "VerticesReached",
+      "TargetReached", "StopReason", "MeasuredClearance", "MeasuredClearanceRelative", "EnclosureVerified",
+      "RemovedPockets", "EnvelopeGenus", "EnvelopeComponents", "VoxelSizeUsed", "InputWasFlipped",
+      "NumberOfActivePoints", "ActivePointTime", "TopologyWarning", "MergedPoints", "MergeTolerance",
+      "TriangulatedPolygons", "DroppedDegenerateTriangles", "DroppedDuplicateTriangles", "IgnoredCells",
+      "InputBoundaryEdges", "InputNonManifoldEdges", "InputNonManifoldVertices", "InputInconsistentEdges",
+      "InputComponents", "InputClosed", "InputGenus", "SignMode", "SignReason", "WindingTime" })
   {
     EXPECT_NE(findResult(cage, name), nullptr) << "cageResults has no " << name;
   }
   const ResultTable optimize = optimizeResults(OptimizeResult(), 0.0);
-  for (const char* name : { "EnergyBefore", "EnergyAfter", "MinimumAngleBefore", "MinimumAngleAfter",
-         "MeasuredClearance", "MeasuredClearanceRelative", "ClearanceUsed", "NumberOfMoves", "NumberOfFlips",
-         "Reverted", "OptimizationTime" })
+  for (const char* name :
+    { "EnergyBefore", "EnergyAfter", "MinimumAngleBefore", "MinimumAngleAfter", "MeasuredClearance",
+      "MeasuredClearanceRelative", "ClearanceUsed", "NumberOfMoves", "NumberOfFlips", "Reverted", "OptimizationTime" })
   {
     EXPECT_NE(findResult(optimize, name), nullptr) << "optimizeResults has no " << name;
   }

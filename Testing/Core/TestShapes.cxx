@@ -36,8 +36,7 @@ double componentGap(const TriangleMesh& mesh)
 {
   std::vector<int> comp;
   EXPECT_EQ(triangleComponents(mesh, comp), 2);
-  const exact::ExactReport r =
-    exact::exactCheck(component(mesh, comp, 0), component(mesh, comp, 1), 1.0);
+  const exact::ExactReport r = exact::exactCheck(component(mesh, comp, 0), component(mesh, comp, 1), 1.0);
   EXPECT_EQ(r.InputIntersections, 0);
   EXPECT_FALSE(r.ClearanceIsLowerBound);
   return r.MinimumClearance;

@@ -51,9 +51,9 @@ void expectValidCage(const TriangleMesh& input, const CageResult& r, const std::
   ASSERT_EQ(r.State, Status::Ok) << what << ": " << r.Message;
   const double delta = r.Normalize.lengthToInput(CageOptions().Envelope.clearance());
   const exact::ExactReport e = exact::exactCheck(input, r.Cage, 4 * delta);
-  std::cout << "[ cage     ] " << what << ": " << r.Cage.Points.size() << " vertices, clearance "
-            << e.MinimumClearance << " (delta " << delta << "), genus " << e.CageGenus
-            << " (envelope " << r.EnvelopeGenus << "), simplification " << r.SimplificationSeconds << " s\n";
+  std::cout << "[ cage     ] " << what << ": " << r.Cage.Points.size() << " vertices, clearance " << e.MinimumClearance
+            << " (delta " << delta << "), genus " << e.CageGenus << " (envelope " << r.EnvelopeGenus
+            << "), simplification " << r.SimplificationSeconds << " s\n";
   EXPECT_TRUE(e.Closed2Manifold) << what;
   EXPECT_EQ(e.SelfIntersections, 0) << what;
   EXPECT_EQ(e.InputIntersections, 0) << what;
@@ -145,11 +145,10 @@ TEST(Simplification, PlainQEMFailsWhereConstrainedPasses)
     const SimplifyResult qem = simplifyEnvelope(env.Envelope, tree, plain);
     const exact::ExactReport eOurs = exact::exactCheck(unit, ours.Cage, 4 * so.Clearance);
     const exact::ExactReport eQem = exact::exactCheck(unit, qem.Cage, 4 * so.Clearance);
-    std::cout << "[ qem      ] " << shape.first << ": plain QEM " << qem.VerticesReached
-              << " vertices, encloses " << eQem.Encloses << ", input intersections "
-              << eQem.InputIntersections << ", outside " << eQem.InputVerticesOutside
-              << "; constrained " << ours.VerticesReached << " vertices, encloses " << eOurs.Encloses
-              << ", clearance " << eOurs.MinimumClearance << "\n";
+    std::cout << "[ qem      ] " << shape.first << ": plain QEM " << qem.VerticesReached << " vertices, encloses "
+              << eQem.Encloses << ", input intersections " << eQem.InputIntersections << ", outside "
+              << eQem.InputVerticesOutside << "; constrained " << ours.VerticesReached << " vertices, encloses "
+              << eOurs.Encloses << ", clearance " << eOurs.MinimumClearance << "\n";
     EXPECT_FALSE(eQem.Encloses && eQem.MinimumClearance >= so.Clearance) << shape.first;
     EXPECT_TRUE(eOurs.Encloses) << shape.first;
     EXPECT_GE(eOurs.MinimumClearance, so.Clearance * (1 - 1e-9)) << shape.first;

@@ -37,8 +37,7 @@ PolygonMesh quadCube()
 }
 
 /// Tetrahedron with outward faces.
-void addTetrahedron(PolygonMesh& m, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d,
-  int shareA = -1)
+void addTetrahedron(PolygonMesh& m, const Vec3& a, const Vec3& b, const Vec3& c, const Vec3& d, int shareA = -1)
 {
   const std::int64_t base = static_cast<std::int64_t>(m.Points.size());
   std::int64_t ia = shareA;
@@ -179,7 +178,7 @@ TEST(Validation, NonConvexPolygonIsSplitByEars)
       m.Points.emplace_back(p[0], p[1], z);
     }
   }
-  m.addCell({ 0, 5, 4, 3, 2, 1 }); // bottom, facing -z
+  m.addCell({ 0, 5, 4, 3, 2, 1 });   // bottom, facing -z
   m.addCell({ 6, 7, 8, 9, 10, 11 }); // top, facing +z
   for (int i = 0; i < 6; ++i)
   {
@@ -192,7 +191,7 @@ TEST(Validation, NonConvexPolygonIsSplitByEars)
   EXPECT_EQ(d.TriangulatedPolygons, 8);
   EXPECT_TRUE(d.usable()) << d.errorMessage();
   EXPECT_EQ(out.Triangles.size(), 2u * 4u + 6u * 2u); // each hexagon in 4 ears, each quad in 2
-  EXPECT_NEAR(signedVolume(out), 3.0, 1e-12);          // the L (area 3) times height 1: no overlap
+  EXPECT_NEAR(signedVolume(out), 3.0, 1e-12);         // the L (area 3) times height 1: no overlap
 }
 
 TEST(Validation, BoundaryEdgesOfAnOpenBox)

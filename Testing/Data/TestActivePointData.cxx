@@ -70,9 +70,9 @@ TEST_P(ActivePointData, ShapeAwareEnvelopeKeepsTopology)
 
   const EnvelopeResult env = buildEnvelope(unit, options);
   ASSERT_EQ(env.State, Status::Ok) << env.Message;
-  std::cout << "[ envelope ] " << env.Envelope.Triangles.size() << " triangles, genus " << env.Genus
-            << ", components " << env.Components << ", amplified voxels " << env.AmplifiedVoxels
-            << ", projected vertices " << env.ProjectedVertices << ", clearance >= " << env.MinimumClearance << "\n";
+  std::cout << "[ envelope ] " << env.Envelope.Triangles.size() << " triangles, genus " << env.Genus << ", components "
+            << env.Components << ", amplified voxels " << env.AmplifiedVoxels << ", projected vertices "
+            << env.ProjectedVertices << ", clearance >= " << env.MinimumClearance << "\n";
   EXPECT_GT(env.NumberOfActiveSamples, 0u);
   EXPECT_GT(env.AmplifiedVoxels, 0u);
   EXPECT_EQ(env.Genus, inputGenus);

@@ -53,8 +53,7 @@ TEST(DataMesh, GenerateCage)
 {
   if (gMesh.empty())
   {
-    GTEST_SKIP() << "no test meshes: the data folder '" << gDataDir
-                 << "' is absent or empty (set SDFCAGE_DATA_DIR)";
+    GTEST_SKIP() << "no test meshes: the data folder '" << gDataDir << "' is absent or empty (set SDFCAGE_DATA_DIR)";
   }
   if (!std::ifstream(gMesh).good())
   {
@@ -67,8 +66,8 @@ TEST(DataMesh, GenerateCage)
   std::string error;
   ASSERT_TRUE(exact::readPolygonMesh(gMesh, polygons, error)) << error;
   const double readSeconds = since(t0);
-  std::cout << "[ data     ] " << name << ": " << polygons.Points.size() << " points, "
-            << polygons.numberOfCells() << " cells, read in " << readSeconds << " s\n";
+  std::cout << "[ data     ] " << name << ": " << polygons.Points.size() << " points, " << polygons.numberOfCells()
+            << " cells, read in " << readSeconds << " s\n";
   ASSERT_GT(polygons.numberOfCells(), 0u);
 
   CageOptions options;
@@ -79,20 +78,18 @@ TEST(DataMesh, GenerateCage)
   t0 = std::chrono::steady_clock::now();
   const CageResult result = generateCage(polygons, options);
   const double cageSeconds = since(t0);
-  std::cout << "[ data     ] " << name << ": " << statusName(result.State) << " in " << cageSeconds
-            << " s (validation " << result.ValidationSeconds << ", SDF " << result.DistanceFieldSeconds
-            << ", isosurface " << result.IsosurfaceSeconds << ", verification "
-            << result.VerificationSeconds << ")\n";
+  std::cout << "[ data     ] " << name << ": " << statusName(result.State) << " in " << cageSeconds << " s (validation "
+            << result.ValidationSeconds << ", SDF " << result.DistanceFieldSeconds << ", isosurface "
+            << result.IsosurfaceSeconds << ", verification " << result.VerificationSeconds << ")\n";
   RecordProperty("GenerateCageSeconds", std::to_string(cageSeconds));
 
   const MeshDefects& d = result.Defects;
   std::cout << "[ data     ] " << name << ": repairs: " << d.MergedPoints << " points merged, "
             << d.TriangulatedPolygons << " polygons triangulated, " << d.DroppedDegenerateTriangles
-            << " degenerate and " << d.DroppedDuplicateTriangles << " duplicated triangles dropped; "
-            << d.BoundaryEdges << " boundary edges, " << d.NonManifoldEdges << " non-manifold edges, "
-            << d.NonManifoldVertices << " non-manifold vertices, " << d.InconsistentEdges
-            << " inconsistent edges, " << d.Components << " components; inside rule "
-            << signModeName(result.SignUsed) << " (" << result.SignReason << ")\n";
+            << " degenerate and " << d.DroppedDuplicateTriangles << " duplicated triangles dropped; " << d.BoundaryEdges
+            << " boundary edges, " << d.NonManifoldEdges << " non-manifold edges, " << d.NonManifoldVertices
+            << " non-manifold vertices, " << d.InconsistentEdges << " inconsistent edges, " << d.Components
+            << " components; inside rule " << signModeName(result.SignUsed) << " (" << result.SignReason << ")\n";
 
   ASSERT_EQ(result.State, Status::Ok) << statusName(result.State) << ": " << result.Message;
   EXPECT_TRUE(result.EnclosureVerified);
@@ -111,12 +108,10 @@ TEST(DataMesh, GenerateCage)
   EXPECT_TRUE(exact::fanTriangulate(polygons, input));
   const Normalization& n = result.Normalize;
   const double delta = n.lengthToInput(options.Envelope.clearance());
-  std::cout << "[ data     ] " << name << ": envelope " << result.Envelope.Triangles.size()
-            << " triangles (voxel " << result.VoxelSizeUsed << ", removed pockets "
-            << result.RemovedPockets << "); cage " << result.VerticesReached << " vertices, "
-            << result.Cage.Triangles.size() << " triangles (simplification "
-            << result.SimplificationSeconds << " s, cage verification "
-            << result.CageVerificationSeconds << " s)\n";
+  std::cout << "[ data     ] " << name << ": envelope " << result.Envelope.Triangles.size() << " triangles (voxel "
+            << result.VoxelSizeUsed << ", removed pockets " << result.RemovedPockets << "); cage "
+            << result.VerticesReached << " vertices, " << result.Cage.Triangles.size() << " triangles (simplification "
+            << result.SimplificationSeconds << " s, cage verification " << result.CageVerificationSeconds << " s)\n";
   RecordProperty("EnvelopeTriangles", std::to_string(result.Envelope.Triangles.size()));
   RecordProperty("CageVertices", std::to_string(result.VerticesReached));
 
@@ -140,17 +135,15 @@ TEST(DataMesh, GenerateCage)
               << "[ data     ] " << what << ": clearance " << n.lengthToUnit(r.MinimumClearance)
               << " unit-sphere units (promised " << options.Envelope.clearance() << ")\n"
               << "[ data     ] " << what << ": input genus " << result.Defects.Genus << ", components "
-              << result.Defects.Components << "; " << checks[k].What << " genus " << r.CageGenus
-              << ", components " << r.CageComponents
+              << result.Defects.Components << "; " << checks[k].What << " genus " << r.CageGenus << ", components "
+              << r.CageComponents
               << (r.CageGenus == result.Defects.Genus && r.CageComponents == result.Defects.Components
                      ? " (topology kept)\n"
                      : " (topology NOT kept)\n");
     RecordProperty(std::string(checks[k].What) + "ExactCheckSeconds", std::to_string(r.Seconds));
-    RecordProperty(std::string(checks[k].What) + "ClearanceUnit",
-      std::to_string(n.lengthToUnit(r.MinimumClearance)));
-    EXPECT_TRUE(r.Closed2Manifold) << what << ": boundary edges " << r.BoundaryEdges
-                                   << ", non-manifold edges " << r.NonManifoldEdges << ", vertices "
-                                   << r.NonManifoldVertices;
+    RecordProperty(std::string(checks[k].What) + "ClearanceUnit", std::to_string(n.lengthToUnit(r.MinimumClearance)));
+    EXPECT_TRUE(r.Closed2Manifold) << what << ": boundary edges " << r.BoundaryEdges << ", non-manifold edges "
+                                   << r.NonManifoldEdges << ", vertices " << r.NonManifoldVertices;
     EXPECT_EQ(r.SelfIntersections, 0) << what;
     EXPECT_EQ(r.InputIntersections, 0) << what;
     EXPECT_EQ(r.InputVerticesOutside, 0) << what;
@@ -207,9 +200,9 @@ TEST(DataMesh, GenerateCage)
   EXPECT_FALSE(opt.Reverted) << opt.Message;
   const exact::ExactReport r = exact::exactCheck(input, opt.Cage, n.lengthToInput(0.25));
   std::cout << "[ data     ] " << name << " optimized: MIPS " << opt.EnergyBefore << " -> " << opt.EnergyAfter
-            << ", min angle " << opt.MinimumAngleBefore << " -> " << opt.MinimumAngleAfter << " deg, "
-            << opt.Moves << " moves, " << opt.Flips << " flips, relocation + flips "
-            << opt.RelocationSeconds + opt.FlipSeconds << " s; exact " << exact::toJson(r) << "\n";
+            << ", min angle " << opt.MinimumAngleBefore << " -> " << opt.MinimumAngleAfter << " deg, " << opt.Moves
+            << " moves, " << opt.Flips << " flips, relocation + flips " << opt.RelocationSeconds + opt.FlipSeconds
+            << " s; exact " << exact::toJson(r) << "\n";
   RecordProperty("OptimizationSeconds", std::to_string(opt.Seconds));
   EXPECT_LT(opt.EnergyAfter, opt.EnergyBefore);
   EXPECT_EQ(opt.Cage.Points.size(), result.Cage.Points.size());

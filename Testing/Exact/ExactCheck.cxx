@@ -34,8 +34,7 @@ using K = CGAL::Exact_predicates_inexact_constructions_kernel;
 using P3 = K::Point_3;
 using S3 = K::Segment_3;
 using T3 = K::Triangle_3;
-using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, int,
-  CGAL::Box_intersection_d::ID_EXPLICIT>;
+using Box = CGAL::Box_intersection_d::Box_with_info_d<double, 3, int, CGAL::Box_intersection_d::ID_EXPLICIT>;
 
 /// box_intersection_d switches to brute-force scanning below this many boxes. CGAL's default is
 /// 10; of 10, 100, 500 and 2000, 2000 used the least CPU on surface meshes of 10^5..10^6 small
@@ -201,8 +200,7 @@ double planeBound(const Primitive& a, const Primitive& b)
 
 /// Do two non-degenerate cage triangles sharing ids intersect beyond what they share?
 /// `shared` = number of common ids (1 or 2; 3 is a duplicated triangle and always counts).
-bool adjacentIntersect(const Triangle& ta, const Triangle& tb, const Primitive& a,
-  const Primitive& b, int shared)
+bool adjacentIntersect(const Triangle& ta, const Triangle& tb, const Primitive& a, const Primitive& b, int shared)
 {
   if (shared >= 3)
   {
@@ -234,8 +232,7 @@ bool adjacentIntersect(const Triangle& ta, const Triangle& tb, const Primitive& 
     }
     const S3 oppositeA(a.P[(i + 1) % 3], a.P[(i + 2) % 3]);
     const S3 oppositeB(b.P[(j + 1) % 3], b.P[(j + 2) % 3]);
-    return CGAL::do_intersect(oppositeA, b.triangle()) ||
-      CGAL::do_intersect(oppositeB, a.triangle());
+    return CGAL::do_intersect(oppositeA, b.triangle()) || CGAL::do_intersect(oppositeB, a.triangle());
   }
   // Shared edge (p, q), apexes r (of a) and s (of b): the triangles meet beyond the edge exactly
   // when they are coplanar and r, s lie on the same side of line pq.
@@ -328,8 +325,7 @@ void checkTopology(const TriangleMesh& cage, const std::vector<char>& valid, Exa
       }
     }
   }
-  std::sort(edges.begin(), edges.end(),
-    [](const HalfEdge& x, const HalfEdge& y) { return x.Key < y.Key; });
+  std::sort(edges.begin(), edges.end(), [](const HalfEdge& x, const HalfEdge& y) { return x.Key < y.Key; });
 
   // Components over shared vertices; count V, E, F per component for the genus.
   UnionFind uf(nPoints);
@@ -458,8 +454,8 @@ void checkTopology(const TriangleMesh& cage, const std::vector<char>& valid, Exa
         {
           continue;
         }
-        auto it = std::find_if(firstUse.begin(), firstUse.end(),
-          [w](const std::pair<int, int>& u) { return u.first == w; });
+        auto it =
+          std::find_if(firstUse.begin(), firstUse.end(), [w](const std::pair<int, int>& u) { return u.first == w; });
         if (it == firstUse.end())
         {
           firstUse.emplace_back(w, i);
@@ -489,9 +485,8 @@ void checkTopology(const TriangleMesh& cage, const std::vector<char>& valid, Exa
 /// `oneQueryPerComponent`: no cage triangle touches any input triangle, so each connected input
 /// component lies in a single cell of the cage's complement and one exact query per component
 /// decides for all of its vertices.
-long long countOutside(const TriangleMesh& input, const TriangleMesh& cage,
-  const std::vector<char>& cageValid, bool cageUsable, bool consistentOrientation,
-  bool oneQueryPerComponent)
+long long countOutside(const TriangleMesh& input, const TriangleMesh& cage, const std::vector<char>& cageValid,
+  bool cageUsable, bool consistentOrientation, bool oneQueryPerComponent)
 {
   const int nInput = static_cast<int>(input.Points.size());
   std::vector<char> referenced(input.Points.size(), 0);
@@ -533,8 +528,7 @@ long long countOutside(const TriangleMesh& input, const TriangleMesh& cage,
   {
     // A closed, consistently oriented manifold (checked by id): add it face by face.
     mesh.reserve(static_cast<Mesh::size_type>(cage.Points.size()),
-      static_cast<Mesh::size_type>(cage.Triangles.size() * 3 / 2),
-      static_cast<Mesh::size_type>(cage.Triangles.size()));
+      static_cast<Mesh::size_type>(cage.Triangles.size() * 3 / 2), static_cast<Mesh::size_type>(cage.Triangles.size()));
     for (const Vec3& x : cage.Points)
     {
       mesh.add_vertex(P3(x[0], x[1], x[2]));
@@ -542,8 +536,9 @@ long long countOutside(const TriangleMesh& input, const TriangleMesh& cage,
     for (std::size_t t = 0; t < cage.Triangles.size(); ++t)
     {
       const Triangle& tri = cage.Triangles[t];
-      if (cageValid[t] && mesh.add_face(Mesh::Vertex_index(tri[0]), Mesh::Vertex_index(tri[1]),
-                            Mesh::Vertex_index(tri[2])) == Mesh::null_face())
+      if (cageValid[t] &&
+        mesh.add_face(Mesh::Vertex_index(tri[0]), Mesh::Vertex_index(tri[1]), Mesh::Vertex_index(tri[2])) ==
+          Mesh::null_face())
       {
         return total;
       }
@@ -565,8 +560,8 @@ long long countOutside(const TriangleMesh& input, const TriangleMesh& cage,
       if (cageValid[t])
       {
         const Triangle& tri = cage.Triangles[t];
-        polygons.push_back({ static_cast<std::size_t>(tri[0]), static_cast<std::size_t>(tri[1]),
-          static_cast<std::size_t>(tri[2]) });
+        polygons.push_back(
+          { static_cast<std::size_t>(tri[0]), static_cast<std::size_t>(tri[1]), static_cast<std::size_t>(tri[2]) });
       }
     }
     PMP::orient_polygon_soup(points, polygons);
@@ -688,8 +683,7 @@ ExactReport exactCheck(const TriangleMesh& input, const TriangleMesh& cage, doub
       ++report.InvalidTriangles;
       // ids may still be valid (non-finite point): topology uses ids only when in range
       const int n = static_cast<int>(cage.Points.size());
-      cageValid[t] = (tri[0] >= 0 && tri[0] < n && tri[1] >= 0 && tri[1] < n && tri[2] >= 0 &&
-        tri[2] < n) ? 1 : 0;
+      cageValid[t] = (tri[0] >= 0 && tri[0] < n && tri[1] >= 0 && tri[1] < n && tri[2] >= 0 && tri[2] < n) ? 1 : 0;
       continue;
     }
     cageValid[t] = 1;
@@ -718,8 +712,8 @@ ExactReport exactCheck(const TriangleMesh& input, const TriangleMesh& cage, doub
 
   // --- topology ---
   checkTopology(cage, cageValid, report);
-  report.Closed2Manifold = !cage.Triangles.empty() && report.InvalidTriangles == 0 &&
-    report.BoundaryEdges == 0 && report.NonManifoldEdges == 0 && report.NonManifoldVertices == 0;
+  report.Closed2Manifold = !cage.Triangles.empty() && report.InvalidTriangles == 0 && report.BoundaryEdges == 0 &&
+    report.NonManifoldEdges == 0 && report.NonManifoldVertices == 0;
 
   report.PhaseSeconds[0] = lap();
 
@@ -736,16 +730,19 @@ ExactReport exactCheck(const TriangleMesh& input, const TriangleMesh& cage, doub
       }
     }
     long long count = 0;
-    CGAL::box_self_intersection_d(boxes.begin(), boxes.end(), [&](const Box& x, const Box& y) {
-      const Triangle& ta = cage.Triangles[x.info()];
-      const Triangle& tb = cage.Triangles[y.info()];
-      const Primitive& a = cagePrims[x.info()];
-      const Primitive& b = cagePrims[y.info()];
-      const int shared = sharedIds(ta, tb);
-      const bool hit = shared == 0 ? CGAL::do_intersect(a.triangle(), b.triangle())
-                                   : adjacentIntersect(ta, tb, a, b, shared);
-      count += hit ? 1 : 0;
-    }, CGAL::Box_intersection_d::Box_traits_d<Box>(), kBoxCutoff);
+    CGAL::box_self_intersection_d(
+      boxes.begin(), boxes.end(),
+      [&](const Box& x, const Box& y) {
+        const Triangle& ta = cage.Triangles[x.info()];
+        const Triangle& tb = cage.Triangles[y.info()];
+        const Primitive& a = cagePrims[x.info()];
+        const Primitive& b = cagePrims[y.info()];
+        const int shared = sharedIds(ta, tb);
+        const bool hit =
+          shared == 0 ? CGAL::do_intersect(a.triangle(), b.triangle()) : adjacentIntersect(ta, tb, a, b, shared);
+        count += hit ? 1 : 0;
+      },
+      CGAL::Box_intersection_d::Box_traits_d<Box>(), kBoxCutoff);
     report.SelfIntersections += count;
   }
 
@@ -755,9 +752,8 @@ ExactReport exactCheck(const TriangleMesh& input, const TriangleMesh& cage, doub
   double limit = clearanceQueryLimit;
   if (!(limit > 0.0) || !std::isfinite(limit))
   {
-    const double diagonal = std::sqrt(
-      std::pow(inputBox.xmax() - inputBox.xmin(), 2) + std::pow(inputBox.ymax() - inputBox.ymin(), 2) +
-      std::pow(inputBox.zmax() - inputBox.zmin(), 2));
+    const double diagonal = std::sqrt(std::pow(inputBox.xmax() - inputBox.xmin(), 2) +
+      std::pow(inputBox.ymax() - inputBox.ymin(), 2) + std::pow(inputBox.zmax() - inputBox.zmin(), 2));
     limit = (std::isfinite(diagonal) && diagonal > 0) ? 0.02 * diagonal : 1.0;
   }
   report.ClearanceQueryLimit = limit;
@@ -773,8 +769,8 @@ ExactReport exactCheck(const TriangleMesh& input, const TriangleMesh& cage, doub
       if (cagePrims[t].Size > 0)
       {
         const CGAL::Bbox_3& b = cagePrims[t].Box;
-        cageBoxes.emplace_back(CGAL::Bbox_3(b.xmin() - grow, b.ymin() - grow, b.zmin() - grow,
-                                 b.xmax() + grow, b.ymax() + grow, b.zmax() + grow),
+        cageBoxes.emplace_back(CGAL::Bbox_3(b.xmin() - grow, b.ymin() - grow, b.zmin() - grow, b.xmax() + grow,
+                                 b.ymax() + grow, b.zmax() + grow),
           static_cast<int>(t));
       }
     }
@@ -790,8 +786,9 @@ ExactReport exactCheck(const TriangleMesh& input, const TriangleMesh& cage, doub
     double best2 = grow * grow;
     bool found = false;
     long long hits = 0;
-    CGAL::box_intersection_d(cageBoxes.begin(), cageBoxes.end(), inputBoxes.begin(),
-      inputBoxes.end(), [&](const Box& x, const Box& y) {
+    CGAL::box_intersection_d(
+      cageBoxes.begin(), cageBoxes.end(), inputBoxes.begin(), inputBoxes.end(),
+      [&](const Box& x, const Box& y) {
         const Primitive& a = cagePrims[x.info()];
         const Primitive& b = inputPrims[y.info()];
         if (CGAL::do_overlap(a.Box, b.Box) && intersects(a, b))
@@ -818,7 +815,8 @@ ExactReport exactCheck(const TriangleMesh& input, const TriangleMesh& cage, doub
           best2 = d2;
           found = true;
         }
-      }, CGAL::Box_intersection_d::Box_traits_d<Box>(), kBoxCutoff);
+      },
+      CGAL::Box_intersection_d::Box_traits_d<Box>(), kBoxCutoff);
     report.InputIntersections = hits;
     found = found && best2 <= limit2;
     report.ClearanceIsLowerBound = !found;
@@ -828,16 +826,15 @@ ExactReport exactCheck(const TriangleMesh& input, const TriangleMesh& cage, doub
   report.PhaseSeconds[2] = lap();
 
   // --- input vertices strictly inside ---
-  report.InputVerticesOutside = countOutside(input, cage, cageValid,
-    report.Closed2Manifold && report.DegenerateTriangles == 0, report.InconsistentEdges == 0,
-    report.InputIntersections == 0);
+  report.InputVerticesOutside =
+    countOutside(input, cage, cageValid, report.Closed2Manifold && report.DegenerateTriangles == 0,
+      report.InconsistentEdges == 0, report.InputIntersections == 0);
 
   report.PhaseSeconds[3] = lap();
 
-  report.Encloses = report.Closed2Manifold && report.SelfIntersections == 0 &&
-    report.InputIntersections == 0 && report.InputVerticesOutside == 0;
-  report.Seconds =
-    std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report.Encloses = report.Closed2Manifold && report.SelfIntersections == 0 && report.InputIntersections == 0 &&
+    report.InputVerticesOutside == 0;
+  report.Seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return report;
 }
 
@@ -854,10 +851,9 @@ std::string toJson(const ExactReport& r)
     "\"ClearanceQueryLimit\": %.17g, \"Seconds\": %.6f, \"PhaseSeconds\": [%.6f, %.6f, %.6f, %.6f]}",
     r.BoundaryEdges, r.NonManifoldEdges, r.NonManifoldVertices, r.Closed2Manifold ? "true" : "false",
     r.SelfIntersections, r.InputIntersections, r.InputVerticesOutside, r.MinimumClearance,
-    r.ClearanceIsLowerBound ? "true" : "false", r.CageGenus, r.CageComponents,
-    r.Encloses ? "true" : "false", r.DegenerateTriangles, r.InconsistentEdges, r.InvalidTriangles,
-    r.CageTriangles, r.InputTriangles, r.ClearanceQueryLimit, r.Seconds, r.PhaseSeconds[0],
-    r.PhaseSeconds[1], r.PhaseSeconds[2], r.PhaseSeconds[3]);
+    r.ClearanceIsLowerBound ? "true" : "false", r.CageGenus, r.CageComponents, r.Encloses ? "true" : "false",
+    r.DegenerateTriangles, r.InconsistentEdges, r.InvalidTriangles, r.CageTriangles, r.InputTriangles,
+    r.ClearanceQueryLimit, r.Seconds, r.PhaseSeconds[0], r.PhaseSeconds[1], r.PhaseSeconds[2], r.PhaseSeconds[3]);
   return buffer;
 }
 

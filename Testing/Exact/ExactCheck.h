@@ -67,8 +67,7 @@ struct ExactReport
 /// `clearanceQueryLimit` are measured exactly; a limit <= 0 (or not finite) means 2% of the input's
 /// bounding-box diagonal. Never throws or crashes on broken cages (open, non-manifold, empty,
 /// invalid ids, NaN points): it reports counts.
-ExactReport exactCheck(const TriangleMesh& input, const TriangleMesh& cage,
-  double clearanceQueryLimit);
+ExactReport exactCheck(const TriangleMesh& input, const TriangleMesh& cage, double clearanceQueryLimit);
 
 /// The report as one JSON object (field names as in ExactReport).
 std::string toJson(const ExactReport& report);

@@ -55,8 +55,8 @@ std::string lowerExtension(const std::string& path)
     return std::string();
   }
   std::string ext = path.substr(dot + 1);
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(
+    ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return ext;
 }
 
@@ -554,7 +554,7 @@ bool readPLY(const std::string& path, PolygonMesh& mesh, std::string& error)
     {
       std::string f;
       words >> f;
-      format = f == "ascii" ? Format::Ascii
+      format = f == "ascii"           ? Format::Ascii
         : f == "binary_little_endian" ? Format::BinaryLE
         : f == "binary_big_endian"    ? Format::BinaryBE
                                       : Format::Unknown;
@@ -771,8 +771,8 @@ bool fanTriangulate(const PolygonMesh& mesh, TriangleMesh& out)
     }
     for (std::int64_t k = b + 1; k + 1 < e; ++k)
     {
-      out.Triangles.push_back({ static_cast<int>(mesh.Connectivity[b]),
-        static_cast<int>(mesh.Connectivity[k]), static_cast<int>(mesh.Connectivity[k + 1]) });
+      out.Triangles.push_back({ static_cast<int>(mesh.Connectivity[b]), static_cast<int>(mesh.Connectivity[k]),
+        static_cast<int>(mesh.Connectivity[k + 1]) });
     }
   }
   return allValid;

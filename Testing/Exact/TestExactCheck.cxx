@@ -20,8 +20,8 @@
 using sdfcage::Triangle;
 using sdfcage::TriangleMesh;
 using sdfcage::Vec3;
-using sdfcage::exact::ExactReport;
 using sdfcage::exact::exactCheck;
+using sdfcage::exact::ExactReport;
 
 namespace
 {
@@ -34,8 +34,8 @@ TriangleMesh box(const Vec3& lo, const Vec3& hi)
   {
     m.Points.emplace_back(i & 1 ? hi[0] : lo[0], i & 2 ? hi[1] : lo[1], i & 4 ? hi[2] : lo[2]);
   }
-  const int quads[6][4] = { { 0, 2, 3, 1 }, { 4, 5, 7, 6 }, { 0, 1, 5, 4 }, { 2, 6, 7, 3 },
-    { 0, 4, 6, 2 }, { 1, 3, 7, 5 } };
+  const int quads[6][4] = { { 0, 2, 3, 1 }, { 4, 5, 7, 6 }, { 0, 1, 5, 4 }, { 2, 6, 7, 3 }, { 0, 4, 6, 2 },
+    { 1, 3, 7, 5 } };
   for (const auto& q : quads)
   {
     m.Triangles.push_back({ q[0], q[1], q[2] });
@@ -68,8 +68,8 @@ TriangleMesh torus(double major, double minor, int n, int m)
     for (int j = 0; j < m; ++j)
     {
       const double u = 2 * pi * i / n, v = 2 * pi * j / m;
-      mesh.Points.emplace_back((major + minor * std::cos(v)) * std::cos(u),
-        (major + minor * std::cos(v)) * std::sin(u), minor * std::sin(v));
+      mesh.Points.emplace_back(
+        (major + minor * std::cos(v)) * std::cos(u), (major + minor * std::cos(v)) * std::sin(u), minor * std::sin(v));
     }
   }
   auto id = [&](int i, int j) { return (i % n) * m + (j % m); };
@@ -301,8 +301,7 @@ TEST(ExactCheck, InconsistentOrientationStillManifold)
 TEST(ExactCheck, VertexSharingTriangles)
 {
   TriangleMesh crossing;
-  crossing.Points = { Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0.2, 0.2, -1),
-    Vec3(0.2, 0.2, 1) };
+  crossing.Points = { Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 1, 0), Vec3(0.2, 0.2, -1), Vec3(0.2, 0.2, 1) };
   crossing.Triangles = { { 0, 1, 2 }, { 0, 3, 4 } }; // second one pierces the first
   EXPECT_EQ(exactCheck(TriangleMesh(), crossing, 1.0).SelfIntersections, 1);
 
@@ -388,7 +387,7 @@ TEST(ExactCheck, DegenerateAndInvalidTrianglesDoNotCrash)
   EXPECT_FALSE(r.Encloses);
 
   cage = cube(2.0);
-  cage.Triangles.push_back({ 0, 0, 1 }); // repeated id
+  cage.Triangles.push_back({ 0, 0, 1 });  // repeated id
   cage.Triangles.push_back({ 0, 1, 99 }); // id out of range
   cage.Triangles.push_back({ -4, 1, 2 }); // negative id
   r = exactCheck(cube(1.0), cage, 5.0);
@@ -418,8 +417,7 @@ TEST(ExactCheck, TriangleDistanceMatchesDenseSampling)
       a[k] = Vec3(u(rng), u(rng), u(rng));
       b[k] = Vec3(u(rng), u(rng), u(rng)) + Vec3(1.5, 0.3 * trial / 25.0, 0.0);
     }
-    const ExactReport r =
-      exactCheck(singleTriangle(a[0], a[1], a[2]), singleTriangle(b[0], b[1], b[2]), 100.0);
+    const ExactReport r = exactCheck(singleTriangle(a[0], a[1], a[2]), singleTriangle(b[0], b[1], b[2]), 100.0);
     double sampled = std::numeric_limits<double>::infinity();
     std::vector<Vec3> sa, sb;
     for (int i = 0; i <= n; ++i)

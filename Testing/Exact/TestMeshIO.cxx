@@ -30,10 +30,9 @@ void writeText(const std::string& path, const std::string& text)
 }
 
 /// The reference: a unit square pyramid (4 base points as one quad, 4 side triangles).
-const std::vector<Vec3> kPoints = { Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0),
-  Vec3(0.5, 0.5, 0.75) };
-const std::vector<std::vector<std::int64_t>> kCells = { { 0, 3, 2, 1 }, { 0, 1, 4 }, { 1, 2, 4 },
-  { 2, 3, 4 }, { 3, 0, 4 } };
+const std::vector<Vec3> kPoints = { Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0), Vec3(0.5, 0.5, 0.75) };
+const std::vector<std::vector<std::int64_t>> kCells = { { 0, 3, 2, 1 }, { 0, 1, 4 }, { 1, 2, 4 }, { 2, 3, 4 },
+  { 3, 0, 4 } };
 
 void expectPyramid(const PolygonMesh& mesh)
 {
@@ -45,8 +44,8 @@ void expectPyramid(const PolygonMesh& mesh)
   ASSERT_EQ(mesh.numberOfCells(), kCells.size());
   for (std::size_t c = 0; c < kCells.size(); ++c)
   {
-    const std::vector<std::int64_t> cell(mesh.Connectivity.begin() + mesh.Offsets[c],
-      mesh.Connectivity.begin() + mesh.Offsets[c + 1]);
+    const std::vector<std::int64_t> cell(
+      mesh.Connectivity.begin() + mesh.Offsets[c], mesh.Connectivity.begin() + mesh.Offsets[c + 1]);
     EXPECT_EQ(cell, kCells[c]) << "cell " << c;
   }
 }
@@ -72,8 +71,7 @@ TEST(MeshIO, OffWithCommentsColorsAndQuad)
   std::string text = "OFF\n# a comment line\n\n5 5 0\n";
   for (const Vec3& p : kPoints)
   {
-    text += std::to_string(p[0]) + " " + std::to_string(p[1]) + " " + std::to_string(p[2]) +
-      "  # trailing comment\n";
+    text += std::to_string(p[0]) + " " + std::to_string(p[1]) + " " + std::to_string(p[2]) + "  # trailing comment\n";
   }
   for (const auto& cell : kCells)
   {
@@ -149,8 +147,7 @@ TEST(MeshIO, PlyBinaryBothEndiannesses)
   {
     // float xyz + normals, a face list with uchar count and int ids, a trailing extra property,
     // and an extra element after the faces: everything but x, y, z and the ids is skipped.
-    std::string data = std::string("ply\nformat ") +
-      (big ? "binary_big_endian" : "binary_little_endian") +
+    std::string data = std::string("ply\nformat ") + (big ? "binary_big_endian" : "binary_little_endian") +
       " 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\n"
       "property float nx\nproperty float ny\nproperty float nz\n"
       "element face 5\nproperty list uchar int vertex_indices\nproperty ushort flags\n"
@@ -250,7 +247,7 @@ TEST(MeshIO, FanTriangulationAndWriteRoundTrip)
     poly.Connectivity.insert(poly.Connectivity.end(), cell.begin(), cell.end());
     poly.Offsets.push_back(static_cast<std::int64_t>(poly.Connectivity.size()));
   }
-  poly.addCell({ 0, 1 });  // a line: ignored
+  poly.addCell({ 0, 1 }); // a line: ignored
   TriangleMesh tri;
   EXPECT_TRUE(io::fanTriangulate(poly, tri));
   EXPECT_EQ(tri.Triangles.size(), 6u); // quad -> 2, plus 4

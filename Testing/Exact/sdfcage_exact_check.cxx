@@ -39,8 +39,7 @@ bool load(const std::string& path, sdfcage::TriangleMesh& mesh)
   }
   if (!sdfcage::exact::fanTriangulate(polygons, mesh))
   {
-    std::cerr << "sdfcage_exact_check: warning: '" << path
-              << "' has faces with invalid point ids (skipped)\n";
+    std::cerr << "sdfcage_exact_check: warning: '" << path << "' has faces with invalid point ids (skipped)\n";
   }
   return true;
 }

@@ -55,9 +55,10 @@ int TestOptimizeFilter(const Context&)
     filter->SetTargetSpacing(0.03);
     filter->Update();
     vtkPolyData* out = filter->GetOutput();
-    c.Check(std::string(filter->GetStatusString()) == "Ok", name + ": status Ok, got " +
-        filter->GetStatusString() + " " + filter->GetLastErrorMessage());
-    c.Check(out->GetNumberOfPoints() == cage->GetNumberOfPoints() && out->GetNumberOfPolys() == cage->GetNumberOfPolys(),
+    c.Check(std::string(filter->GetStatusString()) == "Ok",
+      name + ": status Ok, got " + filter->GetStatusString() + " " + filter->GetLastErrorMessage());
+    c.Check(
+      out->GetNumberOfPoints() == cage->GetNumberOfPoints() && out->GetNumberOfPolys() == cage->GetNumberOfPolys(),
       name + ": same point and triangle counts");
     c.Check(CountOpenEdges(out) == 0, name + ": closed and manifold");
     c.Check(filter->GetEnergyAfter() < filter->GetEnergyBefore(),
@@ -65,8 +66,8 @@ int TestOptimizeFilter(const Context&)
     c.Check(filter->GetNumberOfMoves() > 0, name + ": vertices moved");
     c.Check(!filter->GetReverted(), name + ": not reverted");
     c.Check(filter->GetMeasuredClearanceRelative() >= filter->GetClearanceUsed() * (1 - 1e-9),
-      name + ": clearance kept " + Str(filter->GetMeasuredClearanceRelative()) + " >= " +
-        Str(filter->GetClearanceUsed()));
+      name + ": clearance kept " + Str(filter->GetMeasuredClearanceRelative()) +
+        " >= " + Str(filter->GetClearanceUsed()));
     auto* distance = vtkDoubleArray::SafeDownCast(out->GetPointData()->GetArray("DistanceToInput"));
     if (c.Check(distance && distance->GetNumberOfTuples() == out->GetNumberOfPoints(), name + ": DistanceToInput"))
     {
@@ -116,10 +117,11 @@ int TestOptimizeFilter(const Context&)
   cager->SetEnergyToSpacing();
   cager->SetTargetSpacing(0.03);
   cager->Update();
-  c.Check(std::string(cager->GetStatusString()) == "Ok", std::string("optimize step: status ") + cager->GetStatusString());
+  c.Check(
+    std::string(cager->GetStatusString()) == "Ok", std::string("optimize step: status ") + cager->GetStatusString());
   c.Check(cager->GetEnclosureVerified(), "optimize step: enclosure verified");
-  c.Check(cager->GetEnergyAfter() < cager->GetEnergyBefore(), "optimize step: energy lowered " +
-      Str(cager->GetEnergyBefore()) + " -> " + Str(cager->GetEnergyAfter()));
+  c.Check(cager->GetEnergyAfter() < cager->GetEnergyBefore(),
+    "optimize step: energy lowered " + Str(cager->GetEnergyBefore()) + " -> " + Str(cager->GetEnergyAfter()));
   c.Check(cager->GetOutput(0)->GetNumberOfPoints() == 150, "optimize step keeps the vertex count");
   c.Check(cager->GetOptimizationTime() > 0, "optimize step: time measured");
   return c.Result();

@@ -92,7 +92,8 @@ int TestQualityGoodCube(const Context&)
   quality->Update();
   vtkPolyData* out = quality->GetOutput();
   c.Check(messages->Errors.empty(), "no error");
-  c.Check(quality->GetEncloses(), "a cube of side 3 encloses the unit sphere: " + std::string(quality->GetQualityMessage()));
+  c.Check(
+    quality->GetEncloses(), "a cube of side 3 encloses the unit sphere: " + std::string(quality->GetQualityMessage()));
   c.Check(FieldValue(out, "Encloses") == 1, "field data Encloses = 1");
   // every result of the filter's table is in the field data, with the getter's value
   c.Check(quality->GetNumberOfResults() >= 18, "the quality table has its 18 results");
@@ -102,16 +103,20 @@ int TestQualityGoodCube(const Context&)
     vtkAbstractArray* a = out->GetFieldData()->GetAbstractArray(name);
     c.Check(a != nullptr && a->GetNumberOfTuples() == 1, std::string("field data has ") + name);
     if (vtkStringArray::SafeDownCast(a))
-      c.Check(FieldText(out, name) == quality->GetResultText(name), std::string("field data ") + name + " = the getter's");
+      c.Check(
+        FieldText(out, name) == quality->GetResultText(name), std::string("field data ") + name + " = the getter's");
     else
-      c.Check(FieldValue(out, name) == quality->GetResultNumber(name), std::string("field data ") + name + " = the getter's");
+      c.Check(
+        FieldValue(out, name) == quality->GetResultNumber(name), std::string("field data ") + name + " = the getter's");
   }
-  c.Check(quality->GetHausdorffCageToInput() == FieldValue(out, "HausdorffCageToInput"), "GetHausdorffCageToInput reads the table");
+  c.Check(quality->GetHausdorffCageToInput() == FieldValue(out, "HausdorffCageToInput"),
+    "GetHausdorffCageToInput reads the table");
   c.Check(out->GetNumberOfCells() == 6 && out->GetNumberOfPoints() == 8, "output is the cage (6 quads, 8 points)");
   // vtkSphereSource puts no vertex on the x and y axes: the clearance is at least 0.5
   c.Check(quality->GetMinimumClearance() >= 0.5 && quality->GetMinimumClearance() < 0.52,
     "clearance in [0.5, 0.52): " + Str(quality->GetMinimumClearance()));
-  c.Check(std::abs(FieldValue(out, "MinimumClearanceRelative") - quality->GetMinimumClearance() / sphere->GetLength()) <= 1e-12,
+  c.Check(std::abs(FieldValue(out, "MinimumClearanceRelative") -
+            quality->GetMinimumClearance() / sphere->GetLength()) <= 1e-12,
     "relative clearance = clearance / the sphere's bounding-box diagonal");
   c.Check(quality->GetSelfIntersections() == 0 && quality->GetInputIntersections() == 0 &&
       quality->GetInputVerticesOutside() == 0,
@@ -124,8 +129,8 @@ int TestQualityGoodCube(const Context&)
     // corners (+-1.5)^3: distance to the sphere about 1.5 sqrt(3) - 1
     for (vtkIdType i = 0; i < 8; ++i)
     {
-      c.Check(std::abs(pd->GetTuple1(i) - (1.5 * std::sqrt(3.0) - 1.0)) < 0.01,
-        "corner distance " + Str(pd->GetTuple1(i)));
+      c.Check(
+        std::abs(pd->GetTuple1(i) - (1.5 * std::sqrt(3.0) - 1.0)) < 0.01, "corner distance " + Str(pd->GetTuple1(i)));
     }
   }
   for (const char* name : { "DistanceToInput", "MinimumAngle", "MIPSEnergy" })
@@ -143,9 +148,10 @@ int TestQualityGoodCube(const Context&)
   {
     c.Check(cellDistance->GetTuple1(0) >= pd->GetTuple1(0) - 1e-12, "cell distance >= its corners'");
   }
-  c.Check(quality->GetHausdorffCageToInput() >= pd->GetRange()[1] - 1e-12,
-    "Hausdorff cage->input >= max corner distance");
-  c.Check(quality->GetHausdorffCageToInputBound() - quality->GetHausdorffCageToInput() <= 1e-4 * 2 * std::sqrt(3.0) + 1e-12,
+  c.Check(
+    quality->GetHausdorffCageToInput() >= pd->GetRange()[1] - 1e-12, "Hausdorff cage->input >= max corner distance");
+  c.Check(
+    quality->GetHausdorffCageToInputBound() - quality->GetHausdorffCageToInput() <= 1e-4 * 2 * std::sqrt(3.0) + 1e-12,
     "Hausdorff certified to the tolerance");
   // input -> cage: the sphere point farthest from the faces is near (1,1,1)/sqrt3: 1.5 - 0.577
   c.Check(quality->GetHausdorffInputToCage() > 0.9 && quality->GetHausdorffInputToCage() < 0.95,
@@ -221,7 +227,8 @@ int TestQualityOfSDFCage(const Context&)
   quality->Update();
   c.Check(cage->GetEnclosureVerified(), "the SDF cage is verified");
   c.Check(quality->GetEncloses(), std::string("the quality filter agrees: ") + quality->GetQualityMessage());
-  c.Check(std::abs(quality->GetMinimumClearance() - cage->GetMeasuredClearance()) <= 1e-9 * cage->GetMeasuredClearance(),
+  c.Check(
+    std::abs(quality->GetMinimumClearance() - cage->GetMeasuredClearance()) <= 1e-9 * cage->GetMeasuredClearance(),
     "the same exact clearance: " + Str(quality->GetMinimumClearance()) + " vs " + Str(cage->GetMeasuredClearance()));
   vtkDataArray* ours = quality->GetOutput()->GetPointData()->GetArray("DistanceToInput");
   vtkDataArray* theirs = cage->GetOutput(0)->GetPointData()->GetArray("DistanceToInput");
@@ -257,7 +264,8 @@ int TestQualityMixedCells(const Context&)
   quality->SetSourceData(Sphere(1.0, 32));
   quality->Update();
   vtkPolyData* out = quality->GetOutput();
-  c.Check(quality->GetEncloses(), std::string("quads + vertex + line cells still enclose: ") + quality->GetQualityMessage());
+  c.Check(
+    quality->GetEncloses(), std::string("quads + vertex + line cells still enclose: ") + quality->GetQualityMessage());
   c.Check(out->GetNumberOfCells() == 8, "8 cells (1 vertex, 1 line, 6 quads): " + Str(out->GetNumberOfCells()));
   vtkDataArray* angle = out->GetCellData()->GetArray("MinimumAngle");
   vtkDataArray* distance = out->GetCellData()->GetArray("DistanceToInput");
@@ -299,9 +307,8 @@ int TestQualityAbort(const Context&)
   quality->SetSourceData(Sphere(1.0, 32));
   // abort from the first progress event (VTK 9.1 clears a flag set before Update)
   vtkNew<vtkCallbackCommand> abort;
-  abort->SetCallback([](vtkObject* caller, unsigned long, void*, void*) {
-    static_cast<vtkAlgorithm*>(caller)->SetAbortExecute(1);
-  });
+  abort->SetCallback(
+    [](vtkObject* caller, unsigned long, void*, void*) { static_cast<vtkAlgorithm*>(caller)->SetAbortExecute(1); });
   quality->AddObserver(vtkCommand::ProgressEvent, abort);
   quality->Update();
   quality->SetAbortExecute(0);

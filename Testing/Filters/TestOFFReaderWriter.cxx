@@ -151,20 +151,17 @@ int TestOFFVariants(const Context& context)
       "# a tetrahedron\nOFF # header\n\n4 4 6 # counts\n0 0 0\n1 0 0 # v1\n0 1 0\n0 0 1\n"
       "# faces\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n",
       4, 4, 0, 0 },
-    { "counts on the header line, no edge count", "OFF 4 1\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n",
-      4, 1, 0, 0 },
+    { "counts on the header line, no edge count", "OFF 4 1\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n", 4, 1, 0, 0 },
     { "no header keyword", "3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", 3, 1, 0, 0 },
     { "COFF with vertex and face colours",
-      "COFF\n3 1 0\n0 0 0 255 0 0 255\n1 0 0 0 255 0 255\n0 1 0 0 0 255 255\n3 0 1 2 0.5 0.5 0.5 1\n",
-      3, 1, 0, 0 },
-    { "NOFF with normals", "NOFF\n3 1 0\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n", 3, 1,
-      0, 0 },
-    { "STCNOFF", "STCNOFF\n3 1 0\n0 0 0 0 0 1 1 1 1 1 0 0\n1 0 0 0 0 1 1 1 1 1 1 0\n"
-                 "0 1 0 0 0 1 1 1 1 1 0 1\n3 0 1 2\n",
+      "COFF\n3 1 0\n0 0 0 255 0 0 255\n1 0 0 0 255 0 255\n0 1 0 0 0 255 255\n3 0 1 2 0.5 0.5 0.5 1\n", 3, 1, 0, 0 },
+    { "NOFF with normals", "NOFF\n3 1 0\n0 0 0 0 0 1\n1 0 0 0 0 1\n0 1 0 0 0 1\n3 0 1 2\n", 3, 1, 0, 0 },
+    { "STCNOFF",
+      "STCNOFF\n3 1 0\n0 0 0 0 0 1 1 1 1 1 0 0\n1 0 0 0 0 1 1 1 1 1 1 0\n"
+      "0 1 0 0 0 1 1 1 1 1 0 1\n3 0 1 2\n",
       3, 1, 0, 0 },
     { "pentagon, segment and point faces",
-      "OFF\n5 3 0\n0 0 0\n1 0 0\n1.5 1 0\n0.5 1.5 0\n-0.5 1 0\n5 0 1 2 3 4\n2 0 2\n1 4\n", 5, 1, 1,
-      1 },
+      "OFF\n5 3 0\n0 0 0\n1 0 0\n1.5 1 0\n0.5 1.5 0\n-0.5 1 0\n5 0 1 2 3 4\n2 0 2\n1 4\n", 5, 1, 1, 1 },
     { "windows line endings and scientific notation",
       "OFF\r\n3 1 0\r\n0 0 0\r\n1e0 0 0\r\n0 1.0E+00 -0e-3\r\n3 0 1 2\r\n", 3, 1, 0, 0 },
     { "no faces", "OFF\n2 0 0\n0 0 0\n1 1 1\n", 2, 0, 0, 0 },
@@ -239,8 +236,7 @@ int TestOFFMalformed(const Context& context)
       mentions = mentions || e.find(m.Expect) != std::string::npos;
     }
     c.Check(mentions, tag + "the error mentions '" + m.Expect + "'");
-    c.Check(r.Data->GetNumberOfPoints() == 0 && r.Data->GetNumberOfCells() == 0,
-      tag + "the output is empty");
+    c.Check(r.Data->GetNumberOfPoints() == 0 && r.Data->GetNumberOfCells() == 0, tag + "the output is empty");
   }
 
   // Missing file and unset file name.
@@ -249,8 +245,8 @@ int TestOFFMalformed(const Context& context)
     "a missing file is an error with an empty output");
   c.Check(vtkOFFReader::CanReadFile((context.Scratch + "/does-not-exist.off").c_str()) == 0,
     "CanReadFile rejects a missing file");
-  c.Check(vtkOFFReader::CanReadFile((context.Scratch + "/malformed2.off").c_str()) == 0,
-    "CanReadFile rejects a PLY file");
+  c.Check(
+    vtkOFFReader::CanReadFile((context.Scratch + "/malformed2.off").c_str()) == 0, "CanReadFile rejects a PLY file");
   {
     vtkNew<vtkOFFReader> reader;
     vtkNew<MessageRecorder> messages;

@@ -26,9 +26,9 @@
 
 #include "Pipeline/CageGenerator.h" // Core: the default options the filter must mirror
 #include "Envelope/ActivePointAnalysis.h"
-#include "Pipeline/Results.h"       // Core: the results table every result must travel by
+#include "Pipeline/Results.h" // Core: the results table every result must travel by
 #include "vtkIdTypeArray.h"
-#include "Mesh/Shapes.h"   // Core: the built-in test shape
+#include "Mesh/Shapes.h" // Core: the built-in test shape
 
 #include <algorithm>
 #include <chrono>
@@ -117,7 +117,8 @@ void CheckResultsTable(Checker& c, vtkSDFCageFilter* filter)
     const char* name = f.Name.c_str();
     if (std::string(filter->GetResultName(static_cast<int>(i))) != f.Name)
     {
-      c.Check(false, "result " + Str(i) + " is " + f.Name + ", the filter says " + filter->GetResultName(static_cast<int>(i)));
+      c.Check(false,
+        "result " + Str(i) + " is " + f.Name + ", the filter says " + filter->GetResultName(static_cast<int>(i)));
     }
     vtkAbstractArray* array = fd->GetAbstractArray(name);
     if (!array || array->GetNumberOfTuples() != 1)
@@ -129,33 +130,41 @@ void CheckResultsTable(Checker& c, vtkSDFCageFilter* filter)
     switch (f.Type)
     {
       case sdfcage::ResultField::Kind::Text:
-        c.Check(vtkStringArray::SafeDownCast(array) != nullptr && FieldString(cage, name) == filter->GetResultText(name),
+        c.Check(
+          vtkStringArray::SafeDownCast(array) != nullptr && FieldString(cage, name) == filter->GetResultText(name),
           std::string("field data ") + name + " is the text of GetResultText");
         break;
       case sdfcage::ResultField::Kind::Flag:
-        c.Check(vtkIntArray::SafeDownCast(array) != nullptr &&
-            (FieldNumber(cage, name) == 0 || FieldNumber(cage, name) == 1),
+        c.Check(
+          vtkIntArray::SafeDownCast(array) != nullptr && (FieldNumber(cage, name) == 0 || FieldNumber(cage, name) == 1),
           std::string("field data ") + name + " is an int flag");
         break;
       case sdfcage::ResultField::Kind::Integer:
-        c.Check(vtkIdTypeArray::SafeDownCast(array) != nullptr, std::string("field data ") + name + " is a vtkIdTypeArray");
+        c.Check(
+          vtkIdTypeArray::SafeDownCast(array) != nullptr, std::string("field data ") + name + " is a vtkIdTypeArray");
         break;
       case sdfcage::ResultField::Kind::Real:
-        c.Check(vtkDoubleArray::SafeDownCast(array) != nullptr, std::string("field data ") + name + " is a vtkDoubleArray");
+        c.Check(
+          vtkDoubleArray::SafeDownCast(array) != nullptr, std::string("field data ") + name + " is a vtkDoubleArray");
         break;
     }
     if (f.Type != sdfcage::ResultField::Kind::Text && FieldNumber(cage, name) != filter->GetResultNumber(name))
     {
-      c.Check(false, std::string("field data ") + name + " = " + Str(FieldNumber(cage, name)) +
-          ", GetResultNumber gives " + Str(filter->GetResultNumber(name)));
+      c.Check(false,
+        std::string("field data ") + name + " = " + Str(FieldNumber(cage, name)) + ", GetResultNumber gives " +
+          Str(filter->GetResultNumber(name)));
     }
   }
   c.Check(missing == 0, "every result of the table is in the field data");
   // the old getters read the same table
-  c.Check(filter->GetMeasuredClearance() == filter->GetResultNumber("MeasuredClearance"), "GetMeasuredClearance = the table's");
-  c.Check(filter->GetVerticesReached() == filter->GetResultNumber("VerticesReached"), "GetVerticesReached = the table's");
-  c.Check(filter->GetEnclosureVerified() == (filter->GetResultNumber("EnclosureVerified") == 1), "GetEnclosureVerified = the table's");
-  c.Check(filter->GetNumberOfActivePoints() == filter->GetResultNumber("NumberOfActivePoints"), "GetNumberOfActivePoints = the table's");
+  c.Check(filter->GetMeasuredClearance() == filter->GetResultNumber("MeasuredClearance"),
+    "GetMeasuredClearance = the table's");
+  c.Check(
+    filter->GetVerticesReached() == filter->GetResultNumber("VerticesReached"), "GetVerticesReached = the table's");
+  c.Check(filter->GetEnclosureVerified() == (filter->GetResultNumber("EnclosureVerified") == 1),
+    "GetEnclosureVerified = the table's");
+  c.Check(filter->GetNumberOfActivePoints() == filter->GetResultNumber("NumberOfActivePoints"),
+    "GetNumberOfActivePoints = the table's");
   c.Check(filter->GetTotalTime() == filter->GetResultNumber("TotalTime"), "GetTotalTime = the table's");
   c.Check(std::string(filter->GetStopReason()) == filter->GetResultText("StopReason"), "GetStopReason = the table's");
   c.Check(std::string(filter->GetResultName(-1)).empty() && filter->GetResultNumber("NoSuchResult") == 0 &&
@@ -168,20 +177,16 @@ void CheckResultsTable(Checker& c, vtkSDFCageFilter* filter)
 void CheckSuccessfulRun(Checker& c, vtkSDFCageFilter* filter, vtkPolyData* input)
 {
   c.Check(std::string(filter->GetStatusString()) == "Ok",
-    std::string("status Ok, got ") + filter->GetStatusString() + ": " +
-      filter->GetLastErrorMessage());
+    std::string("status Ok, got ") + filter->GetStatusString() + ": " + filter->GetLastErrorMessage());
   c.Check(filter->GetEnclosureVerified(), "EnclosureVerified");
   c.Check(filter->GetMeasuredClearance() > 0, "MeasuredClearance > 0");
   c.Check(filter->GetMeasuredClearanceRelative() > 0, "MeasuredClearanceRelative > 0");
-  const double delta =
-    filter->GetMinimumClearance() > 0 ? filter->GetMinimumClearance() : filter->GetIsoValue() / 4;
+  const double delta = filter->GetMinimumClearance() > 0 ? filter->GetMinimumClearance() : filter->GetIsoValue() / 4;
   c.Check(filter->GetMeasuredClearanceRelative() >= delta * (1 - 1e-9),
-    "relative clearance " + Str(filter->GetMeasuredClearanceRelative()) + " >= delta " +
-      Str(delta));
+    "relative clearance " + Str(filter->GetMeasuredClearanceRelative()) + " >= delta " + Str(delta));
   c.Check(filter->GetVoxelSizeUsed() > 0, "VoxelSizeUsed > 0");
   c.Check(filter->GetTotalTime() > 0, "TotalTime > 0");
-  c.Check(filter->GetTotalTime() + 1e-9 >= filter->GetDistanceFieldTime(),
-    "TotalTime >= DistanceFieldTime");
+  c.Check(filter->GetTotalTime() + 1e-9 >= filter->GetDistanceFieldTime(), "TotalTime >= DistanceFieldTime");
   c.Check(std::string(filter->GetLastErrorMessage()).empty(), "no error message");
 
   double inBounds[6];
@@ -190,13 +195,14 @@ void CheckSuccessfulRun(Checker& c, vtkSDFCageFilter* filter, vtkPolyData* input
   {
     const std::string name = port == 0 ? "cage" : "envelope";
     vtkPolyData* out = filter->GetOutput(port);
-    if (!c.Check(out && out->GetNumberOfPoints() > 0 && out->GetNumberOfPolys() > 0,
-          name + " is not empty"))
+    if (!c.Check(out && out->GetNumberOfPoints() > 0 && out->GetNumberOfPolys() > 0, name + " is not empty"))
     {
       continue;
     }
-    c.Check(CountOpenEdges(out) == 0, name + " is closed and manifold (no boundary or "
-                                             "non-manifold edges)");
+    c.Check(CountOpenEdges(out) == 0,
+      name +
+        " is closed and manifold (no boundary or "
+        "non-manifold edges)");
     double outBounds[6];
     out->GetBounds(outBounds);
     for (int a = 0; a < 3; ++a)
@@ -204,21 +210,18 @@ void CheckSuccessfulRun(Checker& c, vtkSDFCageFilter* filter, vtkPolyData* input
       c.Check(outBounds[2 * a] < inBounds[2 * a] && outBounds[2 * a + 1] > inBounds[2 * a + 1],
         name + " bounds strictly contain the input's on axis " + Str(a));
     }
-    auto* distance =
-      vtkDoubleArray::SafeDownCast(out->GetPointData()->GetArray("DistanceToInput"));
+    auto* distance = vtkDoubleArray::SafeDownCast(out->GetPointData()->GetArray("DistanceToInput"));
     if (c.Check(distance != nullptr, name + " has a double array DistanceToInput") &&
-      c.Check(distance->GetNumberOfTuples() == out->GetNumberOfPoints(),
-        name + " DistanceToInput has one value per point"))
+      c.Check(
+        distance->GetNumberOfTuples() == out->GetNumberOfPoints(), name + " DistanceToInput has one value per point"))
     {
       double range[2];
       distance->GetRange(range);
       // MeasuredClearance is the cage's; the envelope only promises delta (in input units:
       // delta x MeasuredClearance / MeasuredClearanceRelative).
       const double bound = port == 0 ? filter->GetMeasuredClearance()
-                                     : delta * filter->GetMeasuredClearance() /
-          filter->GetMeasuredClearanceRelative();
-      c.Check(range[0] >= bound * (1 - 1e-9),
-        name + " min DistanceToInput " + Str(range[0]) + " >= " + Str(bound));
+                                     : delta * filter->GetMeasuredClearance() / filter->GetMeasuredClearanceRelative();
+      c.Check(range[0] >= bound * (1 - 1e-9), name + " min DistanceToInput " + Str(range[0]) + " >= " + Str(bound));
     }
   }
   vtkPolyData* cageOut = filter->GetOutput(0);
@@ -226,8 +229,7 @@ void CheckSuccessfulRun(Checker& c, vtkSDFCageFilter* filter, vtkPolyData* input
     "VerticesReached = cage points (" + Str(filter->GetVerticesReached()) + ")");
   if (filter->GetTargetNumberOfVertices() > 0)
   {
-    c.Check(filter->GetTargetReached() ==
-        (cageOut->GetNumberOfPoints() == filter->GetTargetNumberOfVertices()),
+    c.Check(filter->GetTargetReached() == (cageOut->GetNumberOfPoints() == filter->GetTargetNumberOfVertices()),
       "TargetReached agrees with the cage's vertex count");
     c.Check(cageOut->GetNumberOfPoints() >= filter->GetTargetNumberOfVertices(),
       "the cage has at least TargetNumberOfVertices vertices");
@@ -240,12 +242,11 @@ void CheckSuccessfulRun(Checker& c, vtkSDFCageFilter* filter, vtkPolyData* input
   c.Check(FieldNumber(cage, "EnclosureVerified") == 1, "field data EnclosureVerified = 1");
   c.Check(FieldNumber(cage, "MeasuredClearance") == filter->GetMeasuredClearance(),
     "field data MeasuredClearance equals the getter");
-  c.Check(FieldNumber(cage, "EnvelopeGenus") == filter->GetEnvelopeGenus(),
-    "field data EnvelopeGenus equals the getter");
-  for (const char* name : { "ValidationTime", "DistanceFieldTime", "IsosurfaceTime",
-         "VerificationTime", "SimplificationTime", "CageVerificationTime", "TotalTime",
-         "VerticesReached", "TargetReached", "MeasuredClearanceRelative", "RemovedPockets",
-         "EnvelopeComponents", "VoxelSizeUsed", "InputWasFlipped" })
+  c.Check(
+    FieldNumber(cage, "EnvelopeGenus") == filter->GetEnvelopeGenus(), "field data EnvelopeGenus equals the getter");
+  for (const char* name : { "ValidationTime", "DistanceFieldTime", "IsosurfaceTime", "VerificationTime",
+         "SimplificationTime", "CageVerificationTime", "TotalTime", "VerticesReached", "TargetReached",
+         "MeasuredClearanceRelative", "RemovedPockets", "EnvelopeComponents", "VoxelSizeUsed", "InputWasFlipped" })
   {
     c.Check(!std::isnan(FieldNumber(cage, name)), std::string("field data has ") + name);
   }
@@ -259,16 +260,13 @@ void CheckSuccessfulRun(Checker& c, vtkSDFCageFilter* filter, vtkPolyData* input
 void PrintResults(vtkSDFCageFilter* filter)
 {
   vtkPolyData* cage = filter->GetOutput(0);
-  std::cout << "  status " << filter->GetStatusString() << ", cage " << cage->GetNumberOfPoints()
-            << " points / " << cage->GetNumberOfPolys() << " triangles (target "
-            << filter->GetTargetNumberOfVertices() << (filter->GetTargetReached() ? " reached" : " missed: ")
-            << filter->GetStopReason() << "), envelope "
-            << filter->GetOutput(1)->GetNumberOfPoints() << " points, genus "
-            << filter->GetEnvelopeGenus() << ", pockets removed " << filter->GetRemovedPockets()
-            << ", clearance " << filter->GetMeasuredClearance() << " (relative "
-            << filter->GetMeasuredClearanceRelative() << "), voxel "
-            << filter->GetVoxelSizeUsed() << ", time " << filter->GetTotalTime() << " s (simplify "
-            << filter->GetSimplificationTime() << " s)\n";
+  std::cout << "  status " << filter->GetStatusString() << ", cage " << cage->GetNumberOfPoints() << " points / "
+            << cage->GetNumberOfPolys() << " triangles (target " << filter->GetTargetNumberOfVertices()
+            << (filter->GetTargetReached() ? " reached" : " missed: ") << filter->GetStopReason() << "), envelope "
+            << filter->GetOutput(1)->GetNumberOfPoints() << " points, genus " << filter->GetEnvelopeGenus()
+            << ", pockets removed " << filter->GetRemovedPockets() << ", clearance " << filter->GetMeasuredClearance()
+            << " (relative " << filter->GetMeasuredClearanceRelative() << "), voxel " << filter->GetVoxelSizeUsed()
+            << ", time " << filter->GetTotalTime() << " s (simplify " << filter->GetSimplificationTime() << " s)\n";
 }
 
 } // namespace
@@ -290,15 +288,15 @@ int TestSphere(const Context&)
   filter->Update();
   PrintResults(filter);
 
-  c.Check(messages->Errors.empty(), "no errors" + (messages->Errors.empty() ? std::string() : ": " + messages->Errors[0]));
+  c.Check(
+    messages->Errors.empty(), "no errors" + (messages->Errors.empty() ? std::string() : ": " + messages->Errors[0]));
   c.Check(messages->Warnings.empty(), "no warnings for a clean triangle sphere");
   CheckSuccessfulRun(c, filter, input);
   c.Check(!filter->GetInputWasFlipped(), "an outward sphere is not flipped");
   c.Check(filter->GetEnvelopeGenus() == 0, "the envelope of a sphere has genus 0");
 
   // The normalization maps the sphere onto the unit sphere: input lengths are radius x relative.
-  c.Check(std::abs(filter->GetMeasuredClearance() -
-            filter->GetMeasuredClearanceRelative() * radius) <=
+  c.Check(std::abs(filter->GetMeasuredClearance() - filter->GetMeasuredClearanceRelative() * radius) <=
       1e-6 * filter->GetMeasuredClearance(),
     "MeasuredClearance = MeasuredClearanceRelative x radius");
 
@@ -316,17 +314,15 @@ int TestSphere(const Context&)
       worst = std::max(worst, std::abs(distance->GetValue(i) - expected));
     }
     // facets deviate from the true sphere by < 1% of R at this resolution
-    c.Check(worst < 0.01 * radius,
-      "DistanceToInput matches |p - center| - R within facet error, worst " + Str(worst));
+    c.Check(worst < 0.01 * radius, "DistanceToInput matches |p - center| - R within facet error, worst " + Str(worst));
   }
-  auto* envelopeDistance = vtkDoubleArray::SafeDownCast(
-    filter->GetOutput(1)->GetPointData()->GetArray("DistanceToInput"));
+  auto* envelopeDistance =
+    vtkDoubleArray::SafeDownCast(filter->GetOutput(1)->GetPointData()->GetArray("DistanceToInput"));
   if (envelopeDistance)
   {
     double range[2];
     envelopeDistance->GetRange(range);
-    c.Check(range[1] < 0.05 * radius, "the envelope hugs the sphere (max distance " +
-        Str(range[1]) + " < 5% of R)");
+    c.Check(range[1] < 0.05 * radius, "the envelope hugs the sphere (max distance " + Str(range[1]) + " < 5% of R)");
   }
 
   // Same input, second update without changes: no re-execution, same result.
@@ -348,7 +344,8 @@ int TestBuiltinShape(const Context&)
   filter->SetInputData(input);
   filter->Update();
   PrintResults(filter);
-  c.Check(messages->Errors.empty(), "no errors" + (messages->Errors.empty() ? std::string() : ": " + messages->Errors[0]));
+  c.Check(
+    messages->Errors.empty(), "no errors" + (messages->Errors.empty() ? std::string() : ": " + messages->Errors[0]));
   CheckSuccessfulRun(c, filter, input);
   // A torus beside a sphere: the torus hole is far wider than the offset, so genus >= 1.
   c.Check(filter->GetEnvelopeGenus() >= 1, "the torus' hole survives (genus >= 1)");
@@ -550,8 +547,7 @@ int TestAbort(const Context&)
     const auto t0 = Clock::now();
     filter->Update();
     fullSeconds = std::chrono::duration<double>(Clock::now() - t0).count();
-    std::cout << "  full run " << fullSeconds << " s, " << progress->Events
-              << " progress events\n";
+    std::cout << "  full run " << fullSeconds << " s, " << progress->Events << " progress events\n";
     c.Check(std::string(filter->GetStatusString()) == "Ok", "reference run succeeds");
     c.Check(progress->Events >= 3, "progress is reported during the run");
     c.Check(progress->Events < 1000, "progress events are throttled (" + Str(progress->Events) + ")");
@@ -576,8 +572,8 @@ int TestAbort(const Context&)
       continue;
     }
     const double afterAbort = std::chrono::duration<double>(t1 - progress->FiredAt).count();
-    std::cout << "  " << tag << "status " << filter->GetStatusString() << ", returned "
-              << afterAbort << " s after the abort request\n";
+    std::cout << "  " << tag << "status " << filter->GetStatusString() << ", returned " << afterAbort
+              << " s after the abort request\n";
     c.Check(messages->Errors.empty(), tag + "no error");
     const std::string status = filter->GetStatusString();
     c.Check(status == "Cancelled" || status == "Ok", tag + "status Cancelled (or Ok)");
@@ -593,8 +589,7 @@ int TestAbort(const Context&)
       std::cout << "  " << tag << "cage of " << cage->GetNumberOfPoints() << " points\n";
       c.Check(CountOpenEdges(cage) == 0, tag + "the cage output is closed");
       c.Check(filter->GetEnclosureVerified(), tag + "the cage output is verified");
-      c.Check(cage->GetNumberOfPoints() >= filter->GetTargetNumberOfVertices(),
-        tag + "no fewer vertices than asked");
+      c.Check(cage->GetNumberOfPoints() >= filter->GetTargetNumberOfVertices(), tag + "no fewer vertices than asked");
     }
     // "Promptly": well before a full run would have finished.
     c.Check(afterAbort < 0.5 * fullSeconds + 0.25,
@@ -607,8 +602,7 @@ int TestAbort(const Context&)
     filter->SetAbortExecute(0);
     filter->SetIsoValue(0.04);
     filter->Update();
-    c.Check(std::string(filter->GetStatusString()) == "Ok" &&
-        filter->GetOutput(0)->GetNumberOfPoints() > 0,
+    c.Check(std::string(filter->GetStatusString()) == "Ok" && filter->GetOutput(0)->GetNumberOfPoints() > 0,
       tag + "the next update after a cancel succeeds");
     c.Check(messages->Errors.empty(), tag + "no error in the next update");
   }
@@ -634,8 +628,7 @@ int TestDistanceField(const Context&)
   c.Check(messages->Errors.empty(), "no errors");
   CheckSuccessfulRun(c, filter, input);
 
-  c.Check(std::string(filter->GetOutputDataObject(2)->GetClassName()) == "vtkImageData",
-    "output 2 is a vtkImageData");
+  c.Check(std::string(filter->GetOutputDataObject(2)->GetClassName()) == "vtkImageData", "output 2 is a vtkImageData");
   vtkImageData* image = vtkImageData::SafeDownCast(filter->GetOutputDataObject(2));
   if (!c.Check(image && image->GetNumberOfPoints() > 0, "the distance field is not empty"))
   {
@@ -646,8 +639,8 @@ int TestDistanceField(const Context&)
   double spacing[3], bounds[6];
   image->GetSpacing(spacing);
   image->GetBounds(bounds);
-  std::cout << "  image " << dims[0] << "x" << dims[1] << "x" << dims[2] << ", spacing "
-            << spacing[0] << ", bounds [" << bounds[0] << ", " << bounds[1] << "]\n";
+  std::cout << "  image " << dims[0] << "x" << dims[1] << "x" << dims[2] << ", spacing " << spacing[0] << ", bounds ["
+            << bounds[0] << ", " << bounds[1] << "]\n";
   vtkDataArray* sd = image->GetPointData()->GetArray("SignedDistance");
   if (!c.Check(sd != nullptr, "point array SignedDistance"))
   {
@@ -656,8 +649,7 @@ int TestDistanceField(const Context&)
   // The grid covers the input (and the envelope).
   for (int a = 0; a < 3; ++a)
   {
-    c.Check(bounds[2 * a] < -radius && bounds[2 * a + 1] > radius,
-      "the grid covers the input on axis " + Str(a));
+    c.Check(bounds[2 * a] < -radius && bounds[2 * a + 1] > radius, "the grid covers the input on axis " + Str(a));
   }
   auto valueAt = [&](double x, double y, double z) {
     const double p[3] = { x, y, z };
@@ -666,8 +658,7 @@ int TestDistanceField(const Context&)
   };
   const double inside = valueAt(0, 0, 0);
   const double outside = valueAt(bounds[1], bounds[3], bounds[5]);
-  std::cout << "  SignedDistance at the center " << inside << ", at the grid corner " << outside
-            << "\n";
+  std::cout << "  SignedDistance at the center " << inside << ", at the grid corner " << outside << "\n";
   c.Check(inside < 0, "negative inside (at the center)");
   c.Check(outside > 0, "positive outside (at the grid corner)");
   // Near the surface the values are distances in input units: 0.02 R outside the sphere. The
@@ -675,8 +666,8 @@ int TestDistanceField(const Context&)
   const double probe = valueAt(radius * 1.02, 0, 0);
   const double tolerance = spacing[0] + 0.01 * radius;
   c.Check(std::abs(probe - 0.02 * radius) < tolerance,
-    "value near the surface in input units: " + Str(probe) + " vs " + Str(0.02 * radius) +
-      " (tolerance " + Str(tolerance) + ")");
+    "value near the surface in input units: " + Str(probe) + " vs " + Str(0.02 * radius) + " (tolerance " +
+      Str(tolerance) + ")");
   const double probeIn = valueAt(radius * 0.97, 0, 0);
   c.Check(probeIn < 0, "negative just inside the surface (" + Str(probeIn) + ")");
 
@@ -697,10 +688,9 @@ int TestParameters(const Context&)
   c.Check(filter->GetVoxelSize() == core.VoxelSize, "VoxelSize default = Core's");
   c.Check(filter->GetMinimumClearance() == core.MinimumClearance, "MinimumClearance default = Core's");
   c.Check(filter->GetAdaptivity() == core.Adaptivity, "Adaptivity default = Core's");
-  c.Check(filter->GetMaximumRefinements() == core.MaximumRefinements,
-    "MaximumRefinements default = Core's");
-  c.Check((filter->GetGenerateDistanceField() != 0) == core.KeepDistanceField,
-    "GenerateDistanceField default = Core's");
+  c.Check(filter->GetMaximumRefinements() == core.MaximumRefinements, "MaximumRefinements default = Core's");
+  c.Check(
+    (filter->GetGenerateDistanceField() != 0) == core.KeepDistanceField, "GenerateDistanceField default = Core's");
   c.Check(filter->GetNumberOfThreads() == sdfcage::CageOptions().NumberOfThreads, "NumberOfThreads default = Core's");
   c.Check(filter->GetIsoValue() == 0.01, "IsoValue default is the paper's 0.01");
   c.Check(filter->GetTargetNumberOfVertices() == sdfcage::CageOptions().TargetNumberOfVertices,
@@ -714,11 +704,9 @@ int TestParameters(const Context&)
   c.Check(filter->GetNumberOfThreads() == 0, "NumberOfThreads is clamped to >= 0");
 
   c.Check(filter->GetNumberOfOutputPorts() == 3, "three output ports");
-  c.Check(std::string(filter->GetOutputPortInformation(2)->Get(vtkDataObject::DATA_TYPE_NAME())) ==
-      "vtkImageData",
+  c.Check(std::string(filter->GetOutputPortInformation(2)->Get(vtkDataObject::DATA_TYPE_NAME())) == "vtkImageData",
     "output port 2 is declared as vtkImageData");
-  c.Check(std::string(filter->GetOutputPortInformation(0)->Get(vtkDataObject::DATA_TYPE_NAME())) ==
-      "vtkPolyData",
+  c.Check(std::string(filter->GetOutputPortInformation(0)->Get(vtkDataObject::DATA_TYPE_NAME())) == "vtkPolyData",
     "output port 0 is declared as vtkPolyData");
   std::ostringstream print;
   filter->Print(print);
@@ -747,8 +735,7 @@ int TestParameters(const Context&)
   allThreads->Update();
   vtkPolyData* a = explicitFilter->GetOutput(0);
   vtkPolyData* b = allThreads->GetOutput(0);
-  bool same = a->GetNumberOfPoints() == b->GetNumberOfPoints() &&
-    a->GetNumberOfPolys() == b->GetNumberOfPolys();
+  bool same = a->GetNumberOfPoints() == b->GetNumberOfPoints() && a->GetNumberOfPolys() == b->GetNumberOfPolys();
   for (vtkIdType i = 0; same && i < a->GetNumberOfPoints(); ++i)
   {
     double p[3], q[3];
@@ -767,8 +754,7 @@ int TestParameters(const Context&)
   explicitFilter->SetTargetNumberOfVertices(0);
   explicitFilter->Update();
   CheckSuccessfulRun(c, explicitFilter, input);
-  c.Check(explicitFilter->GetOutput(0)->GetNumberOfPoints() ==
-      explicitFilter->GetOutput(1)->GetNumberOfPoints(),
+  c.Check(explicitFilter->GetOutput(0)->GetNumberOfPoints() == explicitFilter->GetOutput(1)->GetNumberOfPoints(),
     "TargetNumberOfVertices 0: the cage is the envelope");
   return c.Result();
 }
@@ -794,8 +780,8 @@ int RunOnDataFile(const Context& context, const char* name, const char* file)
   filter->SetInputConnection(reader->GetOutputPort());
   filter->Update();
   PrintResults(filter);
-  c.Check(messages->Errors.empty(),
-    "no errors" + (messages->Errors.empty() ? std::string() : ": " + messages->Errors[0]));
+  c.Check(
+    messages->Errors.empty(), "no errors" + (messages->Errors.empty() ? std::string() : ": " + messages->Errors[0]));
   vtkPolyData* input = reader->GetOutput();
   c.Check(input->GetNumberOfPolys() > 0, "the reader produced polygons");
   CheckSuccessfulRun(c, filter, input);
@@ -902,8 +888,8 @@ int TestActivePointsBuiltin(const Context&)
   c.Check(cage->GetUseActivePoints() != 0, "UseActivePoints is on by default");
   cage->Update();
   c.Check(std::string(cage->GetStatusString()) == "Ok", "cage with active points: Ok");
-  c.Check(cage->GetEnvelopeComponents() == 2, "with active points the envelope keeps 2 components (got " +
-      Str(cage->GetEnvelopeComponents()) + ")");
+  c.Check(cage->GetEnvelopeComponents() == 2,
+    "with active points the envelope keeps 2 components (got " + Str(cage->GetEnvelopeComponents()) + ")");
   c.Check(cage->GetEnvelopeGenus() == 1, "and genus 1");
   c.Check(cage->GetNumberOfActivePoints() > 0, "NumberOfActivePoints > 0");
   c.Check(std::string(cage->GetTopologyWarning()).empty(), "no topology warning");
