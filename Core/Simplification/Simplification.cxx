@@ -4,6 +4,7 @@
 #include "Mesh/EdgeKey.h"
 #include "Quality/LocalChangeVeto.h"
 #include "Spatial/CageGrid.h"
+#include "Spatial/Geometry.h"
 #include "Spatial/TriangleTree.h"
 
 #include <algorithm>
