@@ -400,6 +400,11 @@ const char* signModeName(SignMode m)
   return "unknown";
 }
 
+int minimumCageVertices(int components, int genus)
+{
+  return components <= 0 ? 0 : 4 * components + 8 * std::max(genus, 0);
+}
+
 EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOptions& options, Progress* progress,
   double progressEnd, int inputClosed)
 {
@@ -528,6 +533,22 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
       auto t0 = std::chrono::steady_clock::now();
       int pockets = 0;
       TriangleMesh envelope = outerBoundary(surface, pockets);
+      if (options.VertexBudget > 0)
+      {
+        // too many parts and handles for the target: not worth verifying (a wider one follows)
+        std::vector<int> comp;
+        const int parts = triangleComponents(envelope, comp);
+        const int g = checkTriangleMesh(envelope).usable() ? genus(envelope) : 0;
+        if (minimumCageVertices(parts, g) > options.VertexBudget)
+        {
+          result.TooComplex = true;
+          result.Components = parts;
+          result.Genus = g;
+          result.Envelope = std::move(envelope);
+          result.IsosurfaceSeconds += seconds(t0);
+          return true; // stops the extraction; buildEnvelope reports TooComplex
+        }
+      }
       if (amplification && surfaceTree)
       {
         result.ProjectedVertices = projectOntoAmplifiedOffset(envelope, *amplification, *surfaceTree, c, 0.5 * h);
@@ -592,6 +613,16 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
     }
     result.DistanceField = std::move(iso.Field);
     result.ModifiedDistanceField = std::move(iso.ModifiedField);
+    if (result.TooComplex)
+    {
+      result.State = Status::Failed;
+      result.Message = "the envelope has " + std::to_string(result.Components) + " part(s) and genus " +
+        std::to_string(result.Genus) + ": a cage like it needs about " +
+        std::to_string(minimumCageVertices(result.Components, result.Genus)) + " vertices or more";
+      tree();
+      result.InputTree = inputTree;
+      return result;
+    }
     if (accepted)
     {
       std::vector<int> comp;

@@ -69,6 +69,10 @@ struct EnvelopeOptions
   ActivePointOptions ActivePoints;
   /// Keep the sampled SDF as a dense image (for display).
   bool KeepDistanceField = false;
+  /// When > 0: an extracted envelope whose parts and handles need more cage vertices than this
+  /// (minimumCageVertices) is not verified; the result says TooComplex (the pipeline then tries a
+  /// wider envelope, see CageOptions::MaximumEnvelopeWidenings). 0 = off.
+  int VertexBudget = 0;
 
   double voxelSize() const { return VoxelSize > 0 ? VoxelSize : IsoValue / 2; }
   double clearance() const { return MinimumClearance > 0 ? MinimumClearance : IsoValue / 4; }
@@ -112,6 +116,8 @@ struct EnvelopeResult
   /// closer than the parameters can separate were fused, or handles closed): the envelope is
   /// still verified, but the cage will not have the input's topology.
   std::string TopologyWarning;
+  /// The envelope needs more cage vertices than options.VertexBudget: not verified, State Failed.
+  bool TooComplex = false;
   /// The bounding-volume tree of the unit input the verification used (built while the distance
   /// field is computed), for the later stages to reuse.
   std::shared_ptr<const TriangleTree> InputTree;
@@ -125,6 +131,13 @@ struct EnvelopeResult
 /// Progress runs from 0.02 to `progressEnd` of the whole run.
 /// `inputClosed`: 1 the input is a closed, consistently oriented 2-manifold, 0 it is not, -1
 /// unknown (then it is checked here).
+/// About the fewest vertices a cage of `components` parts and total genus `genus` can have: 4 per
+/// part (a tetrahedron) and 8 per handle. The smallest triangulated torus has 7 vertices and a
+/// genus-g surface at least (7 + sqrt(1 + 48 g)) / 2 (Heawood), but those are far too twisted to
+/// keep clear of an input: a handle that does needs a ring of 3 or more vertices around it and 3
+/// or more along it (500-vertex targets fail on envelopes of genus 100 or more).
+int minimumCageVertices(int components, int genus);
+
 EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOptions& options,
   Progress* progress = nullptr, double progressEnd = 1.0, int inputClosed = -1);
 

@@ -71,20 +71,7 @@ double barrierDerivative(double g, double dh)
 /// to the first corner v (the triangle is (v, a, b), counter-clockwise).
 double mips(const Vec3& v, const Vec3& a, const Vec3& b, Vec3* grad)
 {
-  const Vec3 n = (a - v).cross(b - v);
-  const double a2 = n.norm(); // twice the area
-  const double s = (a - v).squaredNorm() + (b - a).squaredNorm() + (v - b).squaredNorm();
-  if (!(a2 > 0))
-    return Inf;
-  const double k = 1.0 / std::sqrt(3.0);
-  const double e = k * s / a2;
-  if (grad)
-  {
-    const Vec3 ds = 2.0 * (2.0 * v - a - b);
-    const Vec3 da2 = (a - b).cross(n / a2);
-    *grad = k * ds / a2 - k * s / (a2 * a2) * da2;
-  }
-  return e;
+  return mipsEnergy(v, a, b, grad);
 }
 
 /// The 3-point degree-2 rule on a triangle: barycentric (2/3, 1/6, 1/6) and its rotations,

@@ -90,7 +90,8 @@ struct OptimizeResult
 };
 
 /// Optimizes `cage` (closed, outward, enclosing `input` with clearance) in unit-sphere units.
-/// `inputTree` indexes `input`. Sequential and deterministic. The given cage is verified first
+/// `inputTree` indexes `input`. Deterministic: relocation runs batches of vertices with
+/// separate neighbourhoods in parallel, with results independent of the thread count. The given cage is verified first
 /// (InvalidInput if it fails); the result is verified with verifyEnclosure and, should that ever
 /// fail, the given cage is returned unchanged with Reverted and a message. Progress stages cover
 /// [progressBegin, progressEnd] of the whole run; a cancel returns the (verified) cage so far with

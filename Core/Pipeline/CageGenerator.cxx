@@ -37,16 +37,6 @@ ScalarImage imageToInput(ScalarImage image, const Normalization& n)
 
 namespace
 {
-/// About the fewest vertices a cage of `components` parts and total genus `genus` can have: 4 per
-/// part (a tetrahedron) and 8 per handle. The smallest triangulated torus has 7 vertices and a
-/// genus-g surface at least (7 + sqrt(1 + 48 g)) / 2 (Heawood), but those are far too twisted to
-/// keep clear of an input: a handle that does needs a ring of 3 or more vertices around it, 3 or
-/// more along it (the 500-vertex target fails on envelopes of genus 100 or more).
-int minimumVertices(int components, int genus)
-{
-  return components <= 0 ? 0 : 4 * components + 8 * std::max(genus, 0);
-}
-
 /// One run of the pipeline. `mayWiden`: a wider envelope will be tried if this one cannot carry
 /// the target, so an envelope whose topology needs more vertices than the target is not
 /// simplified (it could not reach the target; the time is better spent on the wider one).
@@ -87,6 +77,10 @@ CageResult generateOnce(const PolygonMesh& input, const CageOptions& options, Pr
   EnvelopeOptions envelopeOptions = options.Envelope;
   envelopeOptions.ExactEnvelopeClearance =
     envelopeOptions.ExactEnvelopeClearance || options.TargetNumberOfVertices <= 0;
+  if (mayWiden && !result.Defects.usable() && options.TargetNumberOfVertices > 0)
+  {
+    envelopeOptions.VertexBudget = options.TargetNumberOfVertices; // too complex: not even verified
+  }
   EnvelopeResult env = buildEnvelope(
     unit, envelopeOptions, progress, options.TargetNumberOfVertices > 0 ? 0.45 : 1.0, result.Defects.usable() ? 1 : 0);
   result.SignUsed = env.SignUsed;
@@ -106,6 +100,16 @@ CageResult generateOnce(const PolygonMesh& input, const CageOptions& options, Pr
   result.AmplificationSeconds = env.AmplificationSeconds;
   result.TopologyWarning = env.TopologyWarning;
   result.TotalSeconds = seconds(start);
+  if (env.TooComplex)
+  {
+    result.State = Status::Failed;
+    result.EnvelopeTooComplex = true;
+    result.EnvelopeComponents = env.Components;
+    result.EnvelopeGenus = env.Genus;
+    result.VerticesReached = static_cast<int>(env.Envelope.Points.size());
+    result.Message = result.StopReason = env.Message;
+    return result;
+  }
   if (env.State != Status::Ok)
   {
     result.State = env.State;
@@ -130,7 +134,7 @@ CageResult generateOnce(const PolygonMesh& input, const CageOptions& options, Pr
   }
 
   // 4. the cage: constrained simplification of the verified envelope, verified again
-  const int needed = minimumVertices(env.Components, env.Genus);
+  const int needed = minimumCageVertices(env.Components, env.Genus);
   if (mayWiden && !env.InputClosed && options.TargetNumberOfVertices > 0 && needed > options.TargetNumberOfVertices)
   {
     result.State = Status::Failed;

@@ -1,5 +1,6 @@
 #include "Quality/CageQuality.h"
 
+#include "Quality/LocalChangeVeto.h"
 #include "Quality/Verification.h"
 
 #include "Envelope/Envelope.h"
@@ -385,14 +386,7 @@ double triangleMinimumAngle(const Vec3& a, const Vec3& b, const Vec3& c)
 
 double triangleMIPSEnergy(const Vec3& a, const Vec3& b, const Vec3& c)
 {
-  const double area2 = (b - a).cross(c - a).norm(); // twice the area
-  const double sum = (b - a).squaredNorm() + (c - b).squaredNorm() + (a - c).squaredNorm();
-  if (!(area2 > 0.0))
-  {
-    return kInf;
-  }
-  // ||J||_F^2 / det J of the affine map from an equilateral triangle: (a^2+b^2+c^2) / (2 sqrt3 A)
-  return sum / (std::sqrt(3.0) * area2);
+  return mipsEnergy(a, b, c); // the optimizer's energy, one formula
 }
 
 namespace

@@ -32,6 +32,28 @@ inline double triangleQuality(const Vec3& a, const Vec3& b, const Vec3& c)
   return s > 0 ? 2.0 * std::sqrt(3.0) * area2 / s : 0.0;
 }
 
+/// MIPS energy of triangle (v, a, b): ||J||_F^2 / det J of the affine map from an equilateral
+/// triangle, (sum of squared edges) / (2 sqrt(3) area); 2 for equilateral, infinite for
+/// degenerate. With `grad`, its gradient with respect to v. The optimizer's energy and the
+/// quality judge's per-triangle value.
+inline double mipsEnergy(const Vec3& v, const Vec3& a, const Vec3& b, Vec3* grad = nullptr)
+{
+  const Vec3 n = (a - v).cross(b - v);
+  const double a2 = n.norm(); // twice the area
+  const double s = (a - v).squaredNorm() + (b - a).squaredNorm() + (v - b).squaredNorm();
+  if (!(a2 > 0))
+    return std::numeric_limits<double>::infinity();
+  const double k = 1.0 / std::sqrt(3.0);
+  const double e = k * s / a2;
+  if (grad)
+  {
+    const Vec3 ds = 2.0 * (2.0 * v - a - b);
+    const Vec3 da2 = (a - b).cross(n / a2);
+    *grad = k * ds / a2 - k * s / (a2 * a2) * da2;
+  }
+  return e;
+}
+
 /// What the veto says about a local change: accepted, or the first named check that failed.
 enum class LocalChangeVerdict
 {

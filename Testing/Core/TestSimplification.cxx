@@ -12,6 +12,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <functional>
 #include <iostream>
 #include <string>
@@ -154,6 +155,50 @@ TEST(Simplification, PlainQEMFailsWhereConstrainedPasses)
     EXPECT_GE(eOurs.MinimumClearance, so.Clearance * (1 - 1e-9)) << shape.first;
     EXPECT_EQ(eOurs.CageGenus, env.Genus) << shape.first;
   }
+}
+
+TEST(Simplification, DebrisIsNeverSweptOut)
+{
+  // A sphere with 200 tiny triangles (0.004 across) floating 0.016 above it: their offsets fuse
+  // with the sphere's into bumps that the simplification flattens. Without the input's component
+  // probes a collapse can jump over a fragment (no new triangle comes near it) and leave it
+  // outside; with them, the cage keeps every fragment inside.
+  TriangleMesh input = makeSphere(Vec3(0, 0, 0), 1.0, 32, 16);
+  for (int i = 0; i < 200; ++i)
+  {
+    const double z = 1.0 - (i + 0.5) / 100.0, r = std::sqrt(1.0 - z * z), phi = 2.399963 * i;
+    const Vec3 u(r * std::cos(phi), r * std::sin(phi), z);
+    const Vec3 a = u.unitOrthogonal(), b = u.cross(a), c = 1.016 * u;
+    const int base = static_cast<int>(input.Points.size());
+    input.Points.push_back(c + 0.002 * a);
+    input.Points.push_back(c - 0.001 * a + 0.0017 * b);
+    input.Points.push_back(c - 0.001 * a - 0.0017 * b);
+    input.Triangles.push_back({ base, base + 1, base + 2 });
+  }
+  const Normalization n = Normalization::fit(input);
+  const TriangleMesh unit = n.toUnit(input);
+  EnvelopeOptions eo;
+  eo.Sign = SignMode::WindingNumber;
+  const EnvelopeResult env = buildEnvelope(unit, eo);
+  ASSERT_EQ(env.State, Status::Ok) << env.Message;
+  const TriangleTree tree(unit);
+  SimplifyOptions so;
+  so.TargetNumberOfVertices = 300;
+  so.Clearance = eo.clearance();
+  const std::vector<Vec3> probes = componentProbes(unit);
+  ASSERT_EQ(probes.size(), 201u);
+  const SimplifyResult with = simplifyEnvelope(env.Envelope, tree, so, nullptr, &probes);
+  const SimplifyResult without = simplifyEnvelope(env.Envelope, tree, so);
+  const exact::ExactReport eWith = exact::exactCheck(unit, with.Cage, 4 * so.Clearance);
+  const exact::ExactReport eWithout = exact::exactCheck(unit, without.Cage, 4 * so.Clearance);
+  std::cout << "[ debris   ] with probes " << with.VerticesReached << " vertices, encloses " << eWith.Encloses
+            << ", input vertices outside " << eWith.InputVerticesOutside << "; without " << without.VerticesReached
+            << " vertices, encloses " << eWithout.Encloses << ", outside " << eWithout.InputVerticesOutside << "\n";
+  EXPECT_TRUE(eWith.Encloses);
+  EXPECT_EQ(eWith.InputVerticesOutside, 0);
+  EXPECT_EQ(eWith.InputIntersections, 0);
+  EXPECT_GE(eWith.MinimumClearance, so.Clearance * (1 - 1e-9));
+  EXPECT_FALSE(eWithout.Encloses) << "the case no longer shows the jump over a fragment";
 }
 
 TEST(Simplification, DeterministicAcrossThreadCounts)
