@@ -59,6 +59,7 @@ vtkSDFCageFilter::vtkSDFCageFilter()
   this->MinimumClearance = defaults.MinimumClearance;
   this->Adaptivity = defaults.Adaptivity;
   this->MaximumRefinements = defaults.MaximumRefinements;
+  this->MaximumEnvelopeWidenings = cageDefaults.MaximumEnvelopeWidenings;
   this->GenerateDistanceField = defaults.KeepDistanceField ? 1 : 0;
   this->UseActivePoints = defaults.UseActivePoints ? 1 : 0;
   this->ActiveRadius = defaults.ActivePoints.Radius;
@@ -117,6 +118,7 @@ sdfcage::CageOptions CageOptionsOf(vtkSDFCageFilter* f)
   options.Envelope.MinimumClearance = f->GetMinimumClearance();
   options.Envelope.Adaptivity = f->GetAdaptivity();
   options.Envelope.MaximumRefinements = f->GetMaximumRefinements();
+  options.MaximumEnvelopeWidenings = f->GetMaximumEnvelopeWidenings();
   options.Envelope.KeepDistanceField = f->GetGenerateDistanceField() != 0;
   options.Envelope.UseActivePoints = f->GetUseActivePoints() != 0;
   options.Envelope.ActivePoints.Radius = f->GetActiveRadius();
@@ -333,6 +335,7 @@ void vtkSDFCageFilter::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "MinimumClearance: " << this->MinimumClearance << "\n";
   os << indent << "Adaptivity: " << this->Adaptivity << "\n";
   os << indent << "MaximumRefinements: " << this->MaximumRefinements << "\n";
+  os << indent << "MaximumEnvelopeWidenings: " << this->MaximumEnvelopeWidenings << "\n";
   os << indent << "UseActivePoints: " << (this->UseActivePoints ? "On" : "Off") << "\n";
   os << indent << "ActiveRadius: " << this->ActiveRadius << "\n";
   os << indent << "GeodesicThreshold: " << this->GeodesicThreshold << "\n";

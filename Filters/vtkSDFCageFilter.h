@@ -188,6 +188,17 @@ public:
 
   ///@{
   /**
+   * Inputs without a defined topology (open, non-manifold, soups) whose target is not reached get
+   * their envelope rebuilt at twice the isovalue, up to this many times; the cage that reaches
+   * the target, or gets closest, is kept (results IsoValueUsed, EnvelopeWidenings, WideningLog).
+   * Closed inputs are never widened. 0 = off. Default 3.
+   */
+  vtkSetClampMacro(MaximumEnvelopeWidenings, int, 0, 6);
+  vtkGetMacro(MaximumEnvelopeWidenings, int);
+  ///@}
+
+  ///@{
+  /**
    * Shape-aware envelope (paper §3.1), on by default: points of the input that have another
    * surface point closer than ActiveRadius but farther than GeodesicThreshold along the surface
    * (nearly touching parts: fingers, legs, separate components) are "active", and the SDF is
@@ -355,6 +366,7 @@ protected:
   double MinimumClearance;
   double Adaptivity;
   int MaximumRefinements;
+  int MaximumEnvelopeWidenings;
   vtkTypeBool GenerateDistanceField;
   int NumberOfThreads;
   vtkTypeBool UseActivePoints;

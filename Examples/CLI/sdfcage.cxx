@@ -89,6 +89,9 @@ void printUsage(std::ostream& os)
         "      --adaptivity A      isosurface adaptivity in [0, 1]: 0 uniform triangles, larger\n"
         "                          merges flat regions (fewer triangles); default 0.3\n"
         "      --refinements N     times the grid may be refined if verification fails, default 2\n"
+        "      --widenings N       inputs without a defined topology (open, soups) whose target is\n"
+        "                          not reached: rebuild the envelope at twice the isovalue up to N\n"
+        "                          times and keep the closest cage, default 3; 0 = off\n"
         "      --sign S            how the inside of the input is decided: auto (default: flood for\n"
         "                          a closed, consistently oriented mesh, winding otherwise), flood,\n"
         "                          winding (generalized winding number: holes bridged, sheets\n"
@@ -121,8 +124,8 @@ void printUsage(std::ostream& os)
         "enclose INPUT? Exit codes: 0 it encloses, 1 it does not, 2 a file cannot be used.\n"
         "\n"
         "Exit codes: 0 cage written and enclosure verified; 1 enclosure not verified;\n"
-        "2 bad command line or unusable input (missing file, unknown format, open or\n"
-        "non-manifold mesh, ...); 3 an output could not be written or rendered; 130 interrupted.\n";
+        "2 bad command line or unusable input (missing file, unknown format, no triangle,\n"
+        "NaN coordinates, ...); 3 an output could not be written or rendered; 130 interrupted.\n";
 }
 
 struct Options
@@ -137,6 +140,7 @@ struct Options
   double Adaptivity = -1.0; ///< -1 = the filter's default
   int Vertices = -1;        ///< -1 = the filter's default
   int Refinements = -1;     ///< -1 = the filter's default
+  int Widenings = -1;       ///< -1 = the filter's default
   bool NoActivePoints = false;
   double ActiveRadius = -1.0;      ///< -1 = the filter's default
   double GeodesicThreshold = -1.0; ///< -1 = the filter's default
@@ -347,6 +351,9 @@ bool parseBuildOption(ArgumentCursor& a, Options& o, vtkSDFCageFilter* limits)
     o.Adaptivity = a.number(limits->GetAdaptivityMinValue(), limits->GetAdaptivityMaxValue());
   else if (arg == "--refinements")
     o.Refinements = a.integer(limits->GetMaximumRefinementsMinValue(), limits->GetMaximumRefinementsMaxValue());
+  else if (arg == "--widenings")
+    o.Widenings =
+      a.integer(limits->GetMaximumEnvelopeWideningsMinValue(), limits->GetMaximumEnvelopeWideningsMaxValue());
   else if (arg == "--no-active-points")
     o.NoActivePoints = true;
   else if (arg == "--active-radius")
@@ -675,6 +682,8 @@ void configureFilter(vtkSDFCageFilter* filter, const Options& o, RunReport& r)
     filter->SetAdaptivity(o.Adaptivity);
   if (o.Refinements >= 0)
     filter->SetMaximumRefinements(o.Refinements);
+  if (o.Widenings >= 0)
+    filter->SetMaximumEnvelopeWidenings(o.Widenings);
   filter->SetUseActivePoints(o.NoActivePoints ? 0 : 1);
   if (o.ActiveRadius >= 0)
     filter->SetActiveRadius(o.ActiveRadius);

@@ -313,6 +313,44 @@ TEST_P(AnyMesh, GetsAVerifiedCageWithExactlyNVertices)
 INSTANTIATE_TEST_SUITE_P(Inputs, AnyMesh, ::testing::ValuesIn(cases()),
   [](const ::testing::TestParamInfo<Case>& info) { return info.param.Name; });
 
+TEST(AnyMeshWidening, OffKeepsTheIsovalueOnReportsTheWiderEnvelope)
+{
+  // the sphere with floating debris (the AnyMesh case): at the requested isovalue its envelope
+  // has the debris' bumps and handles and stops short of 100 vertices; widened, it reaches them
+  PolygonMesh input;
+  for (const Case& c : cases())
+    if (c.Name == "SphereWithDebris")
+      input = c.Make();
+  ASSERT_FALSE(input.Points.empty());
+  CageOptions options;
+  options.TargetNumberOfVertices = 100;
+  options.MaximumEnvelopeWidenings = 0;
+  const CageResult off = generateCage(input, options);
+  ASSERT_EQ(off.State, Status::Ok) << off.Message;
+  EXPECT_EQ(off.EnvelopeWidenings, 0);
+  EXPECT_EQ(off.IsoValueUsed, options.Envelope.IsoValue);
+  EXPECT_FALSE(off.TargetReached);
+  EXPECT_FALSE(off.StopReason.empty());
+  EXPECT_TRUE(off.WideningLog.empty());
+  options.MaximumEnvelopeWidenings = 3;
+  const CageResult on = generateCage(input, options);
+  ASSERT_EQ(on.State, Status::Ok) << on.Message;
+  EXPECT_TRUE(on.TargetReached) << on.StopReason;
+  EXPECT_GE(on.EnvelopeWidenings, 1);
+  EXPECT_EQ(on.IsoValueUsed, options.Envelope.IsoValue * (1 << on.EnvelopeWidenings));
+  EXPECT_NE(on.WideningLog.find("isovalue 0.01:"), std::string::npos) << on.WideningLog;
+  EXPECT_TRUE(on.EnclosureVerified);
+  // a closed input is never widened, whatever its target
+  CageOptions closed;
+  closed.TargetNumberOfVertices = 5; // a torus cannot have 5 vertices
+  const CageResult torus = generateCage(PolygonMesh::fromTriangles(makeTorus(Vec3(0, 0, 0), 1.0, 0.4, 24, 12)), closed);
+  ASSERT_EQ(torus.State, Status::Ok) << torus.Message;
+  EXPECT_TRUE(torus.InputClosed);
+  EXPECT_FALSE(torus.TargetReached);
+  EXPECT_EQ(torus.EnvelopeWidenings, 0);
+  EXPECT_TRUE(torus.WideningLog.empty());
+}
+
 TEST(AnyMeshRepairs, AreCounted)
 {
   // the split-corner torus: every point but one per position merged, nothing dropped
