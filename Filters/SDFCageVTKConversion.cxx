@@ -193,6 +193,8 @@ const char* StatusIdentifier(sdfcage::Status status)
       return "Cancelled";
     case sdfcage::Status::VerificationFailed:
       return "VerificationFailed";
+    case sdfcage::Status::TopologyChanged:
+      return "TopologyChanged";
     case sdfcage::Status::Failed:
     default:
       return "Failed";

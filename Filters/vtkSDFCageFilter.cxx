@@ -60,6 +60,8 @@ vtkSDFCageFilter::vtkSDFCageFilter()
   this->Adaptivity = defaults.Adaptivity;
   this->MaximumRefinements = defaults.MaximumRefinements;
   this->MaximumEnvelopeWidenings = cageDefaults.MaximumEnvelopeWidenings;
+  this->MaximumTopologyRepairs = defaults.MaximumTopologyRepairs;
+  this->RequireTopology = defaults.RequireTopology ? 1 : 0;
   this->GenerateDistanceField = defaults.KeepDistanceField ? 1 : 0;
   this->UseActivePoints = defaults.UseActivePoints ? 1 : 0;
   this->ActiveRadius = defaults.ActivePoints.Radius;
@@ -119,6 +121,8 @@ sdfcage::CageOptions CageOptionsOf(vtkSDFCageFilter* f)
   options.Envelope.Adaptivity = f->GetAdaptivity();
   options.Envelope.MaximumRefinements = f->GetMaximumRefinements();
   options.MaximumEnvelopeWidenings = f->GetMaximumEnvelopeWidenings();
+  options.Envelope.MaximumTopologyRepairs = f->GetMaximumTopologyRepairs();
+  options.Envelope.RequireTopology = f->GetRequireTopology() != 0;
   options.Envelope.KeepDistanceField = f->GetGenerateDistanceField() != 0;
   options.Envelope.UseActivePoints = f->GetUseActivePoints() != 0;
   options.Envelope.ActivePoints.Radius = f->GetActiveRadius();
@@ -336,6 +340,8 @@ void vtkSDFCageFilter::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Adaptivity: " << this->Adaptivity << "\n";
   os << indent << "MaximumRefinements: " << this->MaximumRefinements << "\n";
   os << indent << "MaximumEnvelopeWidenings: " << this->MaximumEnvelopeWidenings << "\n";
+  os << indent << "MaximumTopologyRepairs: " << this->MaximumTopologyRepairs << "\n";
+  os << indent << "RequireTopology: " << this->RequireTopology << "\n";
   os << indent << "UseActivePoints: " << (this->UseActivePoints ? "On" : "Off") << "\n";
   os << indent << "ActiveRadius: " << this->ActiveRadius << "\n";
   os << indent << "GeodesicThreshold: " << this->GeodesicThreshold << "\n";

@@ -199,6 +199,29 @@ public:
 
   ///@{
   /**
+   * A closed input whose envelope has another genus or number of parts (nearly touching parts
+   * fused) gets its envelope rebuilt up to this many times, each round stronger: the facing-gap
+   * rule beside the paper's active points, the most amplification the clearance allows, a finer
+   * grid, and (automatic clearance only) a lower clearance. Results TopologyRepairs,
+   * TopologyRepairLog, ClearanceUsed. 0 = off. Default 2.
+   */
+  vtkSetClampMacro(MaximumTopologyRepairs, int, 0, 2);
+  vtkGetMacro(MaximumTopologyRepairs, int);
+  ///@}
+
+  ///@{
+  /**
+   * Fail (status TopologyChanged, no cage) instead of producing a cage whose genus or number of
+   * parts differs from the closed input's. Default off: the cage is produced with a warning
+   * (TopologyWarning) naming where the gaps are.
+   */
+  vtkSetMacro(RequireTopology, vtkTypeBool);
+  vtkGetMacro(RequireTopology, vtkTypeBool);
+  vtkBooleanMacro(RequireTopology, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
    * Shape-aware envelope (paper §3.1), on by default: points of the input that have another
    * surface point closer than ActiveRadius but farther than GeodesicThreshold along the surface
    * (nearly touching parts: fingers, legs, separate components) are "active", and the SDF is
@@ -367,6 +390,8 @@ protected:
   double Adaptivity;
   int MaximumRefinements;
   int MaximumEnvelopeWidenings;
+  int MaximumTopologyRepairs;
+  vtkTypeBool RequireTopology;
   vtkTypeBool GenerateDistanceField;
   int NumberOfThreads;
   vtkTypeBool UseActivePoints;

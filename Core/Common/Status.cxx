@@ -19,6 +19,8 @@ const char* statusName(Status s)
       return "verification failed";
     case Status::Failed:
       return "failed";
+    case Status::TopologyChanged:
+      return "topology changed";
   }
   return "unknown";
 }

@@ -26,7 +26,10 @@ enum class Status
   InvalidInput,
   Cancelled,
   VerificationFailed,
-  Failed
+  Failed,
+  /// The envelope's genus or parts differ from the closed input's and the caller required them
+  /// kept (EnvelopeOptions::RequireTopology): no cage.
+  TopologyChanged
 };
 
 const char* statusName(Status s);

@@ -400,6 +400,108 @@ public:
 
   bool isActive(int p) const { return this->Active[p].load(std::memory_order_relaxed) != 0; }
 
+  /// The facing-gap rule (ActivePointOptions::GapRatio) on every sample the paper's rule left
+  /// inactive: the candidates within r whose normals face p's across the gap, and a search from
+  /// p ended when each is settled or beyond ratio |p - q| + slack. Returns the samples it made
+  /// active; false in `ok` when cancelled.
+  std::size_t findFacingGaps(
+    const std::vector<Vec3>& normals, double ratio, double slack, bool& ok, std::vector<int>& madeActive)
+  {
+    std::vector<char> before(this->Samples.size());
+    for (std::size_t k = 0; k < this->Samples.size(); ++k)
+    {
+      before[k] = this->isActive(this->Samples[k]);
+    }
+    tbb::parallel_for(
+      tbb::blocked_range<std::size_t>(0, this->Samples.size(), 512), [&](const tbb::blocked_range<std::size_t>& range) {
+        if (this->Cancelled.load(std::memory_order_relaxed))
+        {
+          return;
+        }
+        Scratch& s = this->Scratches.local();
+        for (std::size_t k = range.begin(); k != range.end(); ++k)
+        {
+          const int p = this->Samples[k];
+          if (before[k])
+          {
+            continue;
+          }
+          const Vec3& x = this->Points[p];
+          const Vec3& np = normals[p];
+          s.Candidates.clear();
+          double reach = 0.0;
+          this->SampleGrid.forEachWithin(x, this->R, [&](int q) {
+            if (q == p)
+            {
+              return;
+            }
+            const Vec3 d = this->Points[q] - x;
+            const double len = d.norm();
+            if (len > 0 && d.dot(np) >= 0.5 * len && -d.dot(normals[q]) >= 0.5 * len)
+            {
+              s.Candidates.push_back(q);
+              s.IsCandidate[q] = 1;
+              reach = std::max(reach, ratio * len + slack);
+            }
+          });
+          if (s.Candidates.empty())
+          {
+            continue;
+          }
+          // a candidate is close along the surface when settled within ratio |p - q| + slack
+          std::size_t remaining = s.Candidates.size();
+          s.Search.run(p, reach, [&](int u, double d) {
+            if (s.IsCandidate[u])
+            {
+              s.IsCandidate[u] = 2;
+              s.AlongOf.emplace_back(u, d);
+              return --remaining != 0;
+            }
+            return true;
+          });
+          bool gap = false;
+          for (int q : s.Candidates)
+          {
+            double along = -1.0;
+            for (const auto& [u, d] : s.AlongOf)
+            {
+              if (u == q)
+              {
+                along = d;
+                break;
+              }
+            }
+            const double len = (this->Points[q] - x).norm();
+            if (along < 0 || along > ratio * len + slack)
+            {
+              gap = true;
+              this->Active[q].store(1, std::memory_order_relaxed);
+            }
+          }
+          if (gap)
+          {
+            this->Active[p].store(1, std::memory_order_relaxed);
+          }
+          for (int q : s.Candidates)
+          {
+            s.IsCandidate[q] = 0;
+          }
+          s.AlongOf.clear();
+        }
+      });
+    ok = !this->Cancelled.load();
+    std::size_t made = 0;
+    for (std::size_t k = 0; k < this->Samples.size(); ++k)
+    {
+      if (!before[k] && this->isActive(this->Samples[k]))
+      {
+        ++made;
+        madeActive.push_back(this->Samples[k]);
+      }
+    }
+    return made;
+  }
+
 private:
   struct Scratch
   {
@@ -412,6 +514,7 @@ private:
     std::vector<char> IsCandidate;           // 0 outside testSample()
     std::vector<int> Candidates;             // of the sample being tested
     std::vector<int> Unsettled, Certifiable; // near the ball being certified
+    std::vector<std::pair<int, double>> AlongOf; // facing-gap rule: candidates settled, distance
   };
 
   /// Cheap certificates: one search of radius l/2 from a centre c settles a ball B; a sample q in
@@ -612,6 +715,10 @@ std::string ActivePointOptions::validate() const
   {
     s << "SampleSpacing must be >= 0. ";
   }
+  if (!(GapRatio >= 0) || !std::isfinite(GapRatio))
+  {
+    s << "GapRatio must be >= 0 (got " << GapRatio << "). ";
+  }
   std::string r = s.str();
   if (!r.empty())
   {
@@ -791,6 +898,33 @@ ActivePoints computeActivePoints(const TriangleMesh& unitInput, const ActivePoin
     result.Cancelled = true;
     result.Seconds = seconds(t0);
     return result;
+  }
+
+  if (options.GapRatio > 0)
+  {
+    // the facing-gap rule, with area-weighted vertex normals of the refined surface
+    std::vector<Vec3> normals(n, Vec3::Zero());
+    for (const Triangle& t : S.Triangles)
+    {
+      const Vec3 a = (S.Points[t[1]] - S.Points[t[0]]).cross(S.Points[t[2]] - S.Points[t[0]]);
+      for (int k = 0; k < 3; ++k)
+      {
+        normals[t[k]] += a;
+      }
+    }
+    for (Vec3& v : normals)
+    {
+      const double len = v.norm();
+      v = len > 0 ? Vec3(v / len) : Vec3::Zero();
+    }
+    bool ok = true;
+    result.NumberOfGapSamples = detection.findFacingGaps(normals, options.GapRatio, spacing, ok, result.GapSamples);
+    if (!ok || progressCancelled(progress))
+    {
+      result.Cancelled = true;
+      result.Seconds = seconds(t0);
+      return result;
+    }
   }
 
   // g_A, and the points flagged active: those within half a spacing of an active sample (the

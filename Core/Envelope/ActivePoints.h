@@ -31,6 +31,15 @@ struct ActivePointOptions
   /// splits, the shape is unchanged) until no edge is longer than this, so coarse inputs are
   /// sampled as densely as fine ones; detection runs on samples at least half of it apart.
   double SampleSpacing = 0.0;
+  /// The facing-gap rule (beyond the paper's; 0 = off, the paper's rule only): a surface point p
+  /// is also active when some point q closer than r faces it across air (the outward normal of
+  /// each points at the other, within 60 degrees) and is farther from p along the surface than
+  /// GapRatio |p - q| + the sample spacing. It finds parts that nearly touch close to where they
+  /// join (a leg beside the body, a claw near the head, a finger near its base), where the
+  /// geodesic distance stays below l, while flat and convex regions and open concave creases
+  /// (along-surface / straight-line distance below GapRatio) stay inactive. The envelope's
+  /// topology repair turns it on (3) when the envelope's genus or parts differ from the input's.
+  double GapRatio = 0.0;
 
   double sampleSpacing() const { return SampleSpacing > 0 ? SampleSpacing : Radius; }
   /// Beyond this geodesic distance phi - 1 < (alpha - 1) * 1e-7: g_A is clamped there.
@@ -52,6 +61,8 @@ struct ActivePoints
   std::size_t NumberOfActiveSamples = 0;     ///< samples found active (the active set A)
   std::size_t NumberOfActivePoints = 0;      ///< Surface points flagged in Active
   std::size_t NumberOfActiveInputPoints = 0; ///< of those, input points
+  std::size_t NumberOfGapSamples = 0;        ///< of the active samples, those found by the facing-gap rule only
+  std::vector<int> GapSamples;               ///< those samples (Surface point ids)
   double Alpha = 3.0;
   double Beta = 8.0;
   double Cutoff = 0.5;

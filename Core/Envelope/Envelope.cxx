@@ -405,7 +405,11 @@ int minimumCageVertices(int components, int genus)
   return components <= 0 ? 0 : 4 * components + 8 * std::max(genus, 0);
 }
 
-EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOptions& options, Progress* progress,
+namespace
+{
+
+/// One envelope with the given options (no topology repair).
+EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOptions& options, Progress* progress,
   double progressEnd, int inputClosed)
 {
   EnvelopeResult result;
@@ -418,6 +422,7 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
   const double c = options.IsoValue;
   double h = options.voxelSize();
   const double delta = options.clearance();
+  result.ClearanceUsed = delta;
   if (!(c > 0.0) || !(h > 0.0) || !(delta > 0.0) || delta >= c)
   {
     result.State = Status::InvalidInput;
@@ -506,6 +511,10 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
     }
     result.NumberOfActivePoints = active.NumberOfActiveInputPoints;
     result.NumberOfActiveSamples = active.NumberOfActiveSamples;
+    for (int id : active.GapSamples)
+    {
+      result.GapSites.push_back(active.Surface.Points[id]);
+    }
     amplification = &active;
     if (!active.empty())
     {
@@ -659,6 +668,169 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
   result.Message +=
     " (after " + std::to_string(attempt) + " attempts with finer grids; try a larger IsoValue or a smaller VoxelSize)";
   return result;
+}
+
+} // namespace
+
+namespace
+{
+
+bool topologyDiffers(const EnvelopeResult& r)
+{
+  return r.State == Status::Ok && r.InputClosed && (r.Genus != r.InputGenus || r.Components != r.InputComponents);
+}
+
+/// Surface area of the input (unit-sphere units): the narrow-band grid holds about area / h^2
+/// voxels along it.
+double surfaceArea(const TriangleMesh& m)
+{
+  double a = 0.0;
+  for (const Triangle& t : m.Triangles)
+  {
+    a += 0.5 * (m.Points[t[1]] - m.Points[t[0]]).cross(m.Points[t[2]] - m.Points[t[0]]).norm();
+  }
+  return a;
+}
+
+/// Up to `count` sites, each at least `apart` from the ones before (the first ones in order).
+std::vector<Vec3> spreadSites(const std::vector<Vec3>& sites, std::size_t count, double apart)
+{
+  std::vector<Vec3> out;
+  for (const Vec3& p : sites)
+  {
+    bool near = false;
+    for (const Vec3& q : out)
+    {
+      near = near || (p - q).norm() < apart;
+    }
+    if (!near)
+    {
+      out.push_back(p);
+      if (out.size() == count)
+      {
+        break;
+      }
+    }
+  }
+  return out;
+}
+
+} // namespace
+
+EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOptions& options, Progress* progress,
+  double progressEnd, int inputClosed)
+{
+  EnvelopeResult first = buildEnvelopeOnce(unitInput, options, progress, progressEnd, inputClosed);
+  const bool repairable = first.SignUsed == SignMode::FloodFill && options.UseActivePoints &&
+    options.MaximumTopologyRepairs > 0 && !first.TooComplex;
+  if (!topologyDiffers(first) || !repairable)
+  {
+    if (topologyDiffers(first) && options.RequireTopology)
+    {
+      first.State = Status::TopologyChanged;
+      first.Message = first.TopologyWarning;
+      first.Envelope = TriangleMesh();
+      first.EnclosureVerified = false;
+    }
+    return first;
+  }
+  // The repair rounds (see EnvelopeOptions::MaximumTopologyRepairs): each is a whole new
+  // envelope with the facing-gap rule, a stronger amplification and a finer grid.
+  const double c = options.IsoValue, h0 = options.voxelSize(), delta0 = options.clearance();
+  const bool automaticClearance = !(options.MinimumClearance > 0);
+  const double area = surfaceArea(unitInput);
+  std::ostringstream log;
+  log << "envelope genus " << first.Genus << ", " << first.Components << " part(s) (input " << first.InputGenus << ", "
+      << first.InputComponents << ")";
+  EnvelopeResult best = std::move(first);
+  int rounds = 0;
+  const int maxRounds = std::min(options.MaximumTopologyRepairs, 2);
+  for (int round = 1; round <= maxRounds; ++round)
+  {
+    EnvelopeOptions o = options;
+    o.MaximumTopologyRepairs = 0;
+    o.RequireTopology = false;
+    o.ActivePoints.GapRatio = options.ActivePoints.GapRatio > 0 ? options.ActivePoints.GapRatio : 3.0;
+    o.VoxelSize = round == 1 ? 0.5 * h0 : 0.25 * h0;
+    const double delta = round == 2 && automaticClearance ? 0.4 * delta0 : delta0;
+    o.MinimumClearance = delta;
+    // the envelope at an active point lies at about c / alpha: keep it 15% beyond the clearance
+    o.ActivePoints.Alpha = std::max(options.ActivePoints.Alpha, c / (1.15 * delta));
+    const double voxels = area / (o.VoxelSize * o.VoxelSize);
+    log << "; round " << round << ": voxel " << o.VoxelSize << ", alpha " << o.ActivePoints.Alpha << ", clearance "
+        << delta;
+    if (voxels > options.MaximumRepairSurfaceVoxels)
+    {
+      log << ": not tried (about " << static_cast<long long>(voxels) << " surface voxels, more than "
+          << static_cast<long long>(options.MaximumRepairSurfaceVoxels) << ")";
+      break;
+    }
+    const std::string stage = "repairing topology (round " + std::to_string(round) + ")";
+    progressStage(progress, stage.c_str(), 0.02, progressEnd);
+    EnvelopeResult r = buildEnvelopeOnce(unitInput, o, progress, progressEnd, inputClosed ? 1 : 0);
+    ++rounds;
+    if (r.State == Status::Cancelled || progressCancelled(progress))
+    {
+      r.State = Status::Cancelled;
+      r.Message = "cancelled";
+      return r;
+    }
+    log << ": " << r.NumberOfActiveSamples << " active samples (" << r.GapSites.size() << " by the gap rule), ";
+    if (r.State != Status::Ok)
+    {
+      log << "not verified";
+      continue;
+    }
+    log << "genus " << r.Genus << ", " << r.Components << " part(s)";
+    const bool better = !topologyDiffers(r);
+    if (better)
+    {
+      r.DistanceFieldSeconds += best.DistanceFieldSeconds;
+      r.IsosurfaceSeconds += best.IsosurfaceSeconds;
+      r.VerificationSeconds += best.VerificationSeconds;
+      r.ActivePointSeconds += best.ActivePointSeconds;
+      best = std::move(r);
+      break;
+    }
+    // keep the first envelope, but remember where the gaps are
+    if (best.GapSites.empty())
+    {
+      best.GapSites = r.GapSites;
+    }
+    best.DistanceFieldSeconds += r.DistanceFieldSeconds;
+    best.IsosurfaceSeconds += r.IsosurfaceSeconds;
+    best.VerificationSeconds += r.VerificationSeconds;
+    best.ActivePointSeconds += r.ActivePointSeconds;
+  }
+  best.TopologyRepairs = rounds;
+  best.TopologyRepairLog = log.str();
+  if (topologyDiffers(best))
+  {
+    std::ostringstream w;
+    w << best.TopologyWarning << "; " << rounds << " repair round(s) did not separate them";
+    const std::vector<Vec3> sites = spreadSites(best.GapSites, 5, 4.0 * c);
+    if (!sites.empty())
+    {
+      w << "; narrow gaps near (unit-sphere units):";
+      for (const Vec3& p : sites)
+      {
+        w << " (" << p.x() << ", " << p.y() << ", " << p.z() << ")";
+      }
+    }
+    best.TopologyWarning = w.str();
+    if (options.RequireTopology)
+    {
+      best.State = Status::TopologyChanged;
+      best.Message = best.TopologyWarning;
+      best.Envelope = TriangleMesh();
+      best.EnclosureVerified = false;
+    }
+  }
+  else
+  {
+    best.TopologyWarning.clear();
+  }
+  return best;
 }
 
 } // namespace sdfcage

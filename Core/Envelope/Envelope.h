@@ -74,6 +74,24 @@ struct EnvelopeOptions
   /// wider envelope, see CageOptions::MaximumEnvelopeWidenings). 0 = off.
   int VertexBudget = 0;
 
+  /// Topology repair, for a closed input whose envelope's genus or number of parts differs from
+  /// the input's (nearly touching parts fused): the envelope is built again, up to this many
+  /// times, each round stronger than the last, and the first whose topology matches is kept
+  /// (else the first one, with TopologyWarning):
+  ///  1. the facing-gap rule joins the paper's (ActivePointOptions::GapRatio 3), the
+  ///     amplification rises to the most the clearance allows (the envelope at 1.15 delta there),
+  ///     and the voxel size halves;
+  ///  2. the voxel size is a quarter of the requested one and, only when the clearance is
+  ///     automatic, the clearance drops to 0.4 delta (a gap narrower than about twice the
+  ///     clearance cannot stay open), the amplification rising with it.
+  /// A round whose grid would hold more than MaximumRepairSurfaceVoxels voxels along the input's
+  /// surface (its area / h^2) is not tried. Needs active points and the flood-fill rule. 0 = off.
+  int MaximumTopologyRepairs = 2;
+  double MaximumRepairSurfaceVoxels = 2.0e7;
+  /// Fail (Status::TopologyChanged, no envelope) instead of accepting an envelope whose genus
+  /// or number of parts differs from the closed input's after the repairs.
+  bool RequireTopology = false;
+
   double voxelSize() const { return VoxelSize > 0 ? VoxelSize : IsoValue / 2; }
   double clearance() const { return MinimumClearance > 0 ? MinimumClearance : IsoValue / 4; }
 };
@@ -116,6 +134,15 @@ struct EnvelopeResult
   /// closer than the parameters can separate were fused, or handles closed): the envelope is
   /// still verified, but the cage will not have the input's topology.
   std::string TopologyWarning;
+  /// Topology repair rounds run (see EnvelopeOptions::MaximumTopologyRepairs) and what each did.
+  int TopologyRepairs = 0;
+  std::string TopologyRepairLog;
+  /// The clearance the envelope was verified with: the requested one, or lowered by the
+  /// topology repair (automatic clearance only). The later stages keep this one.
+  double ClearanceUsed = 0.0;
+  /// Where parts nearly touch across a gap (facing-gap samples, unit-sphere units), when the
+  /// repair ran: the warning names the ones left.
+  std::vector<Vec3> GapSites;
   /// The envelope needs more cage vertices than options.VertexBudget: not verified, State Failed.
   bool TooComplex = false;
   /// The bounding-volume tree of the unit input the verification used (built while the distance

@@ -99,6 +99,9 @@ CageResult generateOnce(const PolygonMesh& input, const CageOptions& options, Pr
   result.ActivePointSeconds = env.ActivePointSeconds;
   result.AmplificationSeconds = env.AmplificationSeconds;
   result.TopologyWarning = env.TopologyWarning;
+  result.TopologyRepairs = env.TopologyRepairs;
+  result.TopologyRepairLog = env.TopologyRepairLog;
+  result.ClearanceUsedRelative = env.ClearanceUsed;
   result.TotalSeconds = seconds(start);
   if (env.TooComplex)
   {
@@ -163,7 +166,7 @@ CageResult generateOnce(const PolygonMesh& input, const CageOptions& options, Pr
     const TriangleTree& tree = env.InputTree ? *env.InputTree : *ownTree;
     SimplifyOptions so = options.Simplify;
     so.TargetNumberOfVertices = options.TargetNumberOfVertices;
-    so.Clearance = options.Envelope.clearance();
+    so.Clearance = env.ClearanceUsed > 0 ? env.ClearanceUsed : options.Envelope.clearance();
     progressStage(progress, "simplifying", 0.45, 0.95);
     const std::vector<Vec3> probes = componentProbes(unit);
     result.Simplification = simplifyEnvelope(env.Envelope, tree, so, progress, &probes);

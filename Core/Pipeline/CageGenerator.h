@@ -71,6 +71,13 @@ struct CageResult
   /// Non-empty when the envelope (and so the cage) does not have the input's genus and
   /// component count: parts closer than the parameters can separate were fused.
   std::string TopologyWarning;
+  /// Envelopes rebuilt to keep the input's topology (EnvelopeOptions::MaximumTopologyRepairs)
+  /// and what each round did.
+  int TopologyRepairs = 0;
+  std::string TopologyRepairLog;
+  /// The clearance every cage triangle keeps (unit-sphere units): the requested or automatic
+  /// one, lowered by the topology repair only when automatic.
+  double ClearanceUsedRelative = 0.0;
   double ValidationSeconds = 0.0;
   double DistanceFieldSeconds = 0.0;
   double IsosurfaceSeconds = 0.0;

@@ -200,6 +200,11 @@ ResultTable cageResults(const CageResult& r)
         "envelopes rebuilt with twice the isovalue to reach the target (inputs without a defined topology only)"),
       text("WideningLog", r.WideningLog,
         "each envelope tried when widening: isovalue, parts, genus, vertices reached, time"),
+      integer("TopologyRepairs", r.TopologyRepairs, "count",
+        "envelopes rebuilt (gap rule, stronger amplification, finer grid) to keep the input's topology"),
+      text("TopologyRepairLog", r.TopologyRepairLog, "what each topology repair round did and found"),
+      real("ClearanceUsed", r.ClearanceUsedRelative, "relative",
+        "clearance every cage triangle keeps (unit-sphere units; lowered by the topology repair only when automatic)"),
     });
   return t;
 }

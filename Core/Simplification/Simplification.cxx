@@ -211,11 +211,16 @@ public:
           relaxShape();
       }
       const long long before = Stats.Collapses;
+      const int excess = AliveVertices - target;
       drain(target, start, r);
 
       // progress: try this pass again on what is now blocked (a bounded number of times: each
-      // retry runs the thorough search on every blocked edge)
-      if (Pass > 0 && Stats.Collapses > before && AliveVertices > target && ++Retries <= MaxRetries)
+      // retry runs the thorough search on every blocked edge). Only while a pass removes a fair
+      // share of what is left (1/16 of the vertices above the target): a pass that frees a few
+      // collapses on a stalled cage thousands above the target costs a thorough search of every
+      // blocked edge each time (minutes on a fused cluster) for nothing.
+      const long long made = Stats.Collapses - before;
+      if (Pass > 0 && made > 0 && made * 16 >= excess && AliveVertices > target && ++Retries <= MaxRetries)
         --Pass;
     }
     const bool cancelled = r.Cancelled;

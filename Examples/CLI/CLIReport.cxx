@@ -271,7 +271,8 @@ void printSummary(std::ostream& os, const RunReport& r)
   }
   os << "clearance   : " << number(r.number("MeasuredClearance"))
      << " (input units) = " << number(r.number("MeasuredClearanceRelative"))
-     << " relative, required >= " << number(r.MinimumClearanceUsed) << " relative\n";
+     << " relative, required >= "
+     << number(r.number("ClearanceUsed") > 0 ? r.number("ClearanceUsed") : r.MinimumClearanceUsed) << " relative\n";
   os << "enclosure verified: " << (r.flag("EnclosureVerified") ? "yes" : "no") << "\n";
 }
 

@@ -92,6 +92,13 @@ void printUsage(std::ostream& os)
         "      --widenings N       inputs without a defined topology (open, soups) whose target is\n"
         "                          not reached: rebuild the envelope at twice the isovalue up to N\n"
         "                          times and keep the closest cage, default 3; 0 = off\n"
+        "      --topology-repairs N\n"
+        "                          a closed input whose envelope fuses nearly touching parts\n"
+        "                          (another genus or number of parts): rebuild it up to N times,\n"
+        "                          each stronger (gap rule, amplification, finer grid, lower\n"
+        "                          automatic clearance), default 2; 0 = off\n"
+        "      --require-topology  exit 1 and write no cage if the cage's genus or number of parts\n"
+        "                          still differs from the closed input's (default: a warning)\n"
         "      --sign S            how the inside of the input is decided: auto (default: flood for\n"
         "                          a closed, consistently oriented mesh, winding otherwise), flood,\n"
         "                          winding (generalized winding number: holes bridged, sheets\n"
@@ -141,6 +148,8 @@ struct Options
   int Vertices = -1;        ///< -1 = the filter's default
   int Refinements = -1;     ///< -1 = the filter's default
   int Widenings = -1;       ///< -1 = the filter's default
+  int TopologyRepairs = -1; ///< -1 = the filter's default
+  bool RequireTopology = false;
   bool NoActivePoints = false;
   double ActiveRadius = -1.0;      ///< -1 = the filter's default
   double GeodesicThreshold = -1.0; ///< -1 = the filter's default
@@ -354,6 +363,11 @@ bool parseBuildOption(ArgumentCursor& a, Options& o, vtkSDFCageFilter* limits)
   else if (arg == "--widenings")
     o.Widenings =
       a.integer(limits->GetMaximumEnvelopeWideningsMinValue(), limits->GetMaximumEnvelopeWideningsMaxValue());
+  else if (arg == "--topology-repairs")
+    o.TopologyRepairs =
+      a.integer(limits->GetMaximumTopologyRepairsMinValue(), limits->GetMaximumTopologyRepairsMaxValue());
+  else if (arg == "--require-topology")
+    o.RequireTopology = true;
   else if (arg == "--no-active-points")
     o.NoActivePoints = true;
   else if (arg == "--active-radius")
@@ -684,6 +698,9 @@ void configureFilter(vtkSDFCageFilter* filter, const Options& o, RunReport& r)
     filter->SetMaximumRefinements(o.Refinements);
   if (o.Widenings >= 0)
     filter->SetMaximumEnvelopeWidenings(o.Widenings);
+  if (o.TopologyRepairs >= 0)
+    filter->SetMaximumTopologyRepairs(o.TopologyRepairs);
+  filter->SetRequireTopology(o.RequireTopology ? 1 : 0);
   filter->SetUseActivePoints(o.NoActivePoints ? 0 : 1);
   if (o.ActiveRadius >= 0)
     filter->SetActiveRadius(o.ActiveRadius);
@@ -785,7 +802,7 @@ int stopCode(const Options& o, RunReport& r, const std::vector<std::string>& fil
     r.ErrorMessage = why;
     return ExitUnusable;
   }
-  if (r.Status != "Ok" && r.Status != "VerificationFailed")
+  if (r.Status != "Ok" && r.Status != "VerificationFailed" && r.Status != "TopologyChanged")
   {
     std::string why = r.ErrorMessage;
     if (why.empty())

@@ -1,0 +1,198 @@
+// SDFCage — Testing: the envelope keeps the input's topology where parts nearly touch, also close
+// to where they join (issue: the paper's r/l rule misses those). Generated closed shapes with
+// gaps from 0.004 to 0.03 (unit-sphere units); each cage is judged by the CGAL referee.
+#include "CoreTestPrinters.h"
+#include "ExactCheck.h"
+#include "MeshIO.h"
+#include "Mesh/Mesh.h"
+#include "Mesh/Normalization.h"
+#include "Mesh/Shapes.h"
+#include "Mesh/Validation.h"
+#include "Envelope/ActivePoints.h"
+#include "Pipeline/CageGenerator.h"
+
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+#include <tuple>
+#include <vector>
+
+using namespace sdfcage;
+
+namespace
+{
+
+const char* shapeName(GapShape s)
+{
+  switch (s)
+  {
+    case GapShape::Hook:
+      return "hook";
+    case GapShape::Cluster:
+      return "cluster";
+    case GapShape::Ring:
+      return "ring";
+    case GapShape::Comb:
+      return "comb";
+  }
+  return "?";
+}
+
+} // namespace
+
+TEST(GapShapes, ClosedGenusZeroSelfIntersectionFree)
+{
+  for (GapShape s : { GapShape::Hook, GapShape::Cluster, GapShape::Ring, GapShape::Comb })
+  {
+    const TriangleMesh m = makeGapShape(s, 0.004);
+    const MeshDefects d = checkTriangleMesh(m);
+    EXPECT_TRUE(d.usable()) << shapeName(s);
+    EXPECT_EQ(genus(m), 0) << shapeName(s);
+    std::vector<int> comp;
+    EXPECT_EQ(triangleComponents(m, comp), s == GapShape::Cluster ? 4 : s == GapShape::Ring ? 2 : 1) << shapeName(s);
+    // the referee on the shape itself (as a "cage" around a far-away speck)
+    const TriangleMesh speck = makeBox(Vec3(5, 5, 5), Vec3(5.001, 5.001, 5.001));
+    const exact::ExactReport e = exact::exactCheck(speck, m, 0.0);
+    EXPECT_EQ(e.SelfIntersections, 0) << shapeName(s);
+    // the named gap, in unit-sphere units: the closest distance between its two sides is the
+    // gap (the hook's tip and its straight part are one component: measured with the tip cut off)
+    if (s == GapShape::Cluster)
+    {
+      const TriangleMesh unit = Normalization::fit(m).toUnit(m);
+      TriangleMesh a, b;
+      for (std::size_t k = 0; k < unit.Triangles.size(); ++k)
+      {
+        (comp[k] == comp[0] ? a : b).Triangles.push_back(unit.Triangles[k]);
+      }
+      a.Points = b.Points = unit.Points;
+      const exact::ExactReport g = exact::exactCheck(a, b, 1.0);
+      EXPECT_NEAR(g.MinimumClearance, 0.004, 1e-6);
+    }
+  }
+}
+
+namespace
+{
+
+/// At the defaults: the cage keeps the input's genus and parts, and the referee accepts it.
+void expectTopologyKept(GapShape s, double gap)
+{
+  const TriangleMesh m = makeGapShape(s, gap);
+  CageOptions o;
+  const CageResult r = generateCage(PolygonMesh::fromTriangles(m), o);
+  std::printf("%-8s gap %.3f: input genus %d, %d part(s); envelope %d, %d; cage %d vertices; %zu active "
+              "points; %d repair round(s); clearance %.4g; %.2f s\n  %s\n",
+    shapeName(s), gap, r.InputGenus, r.InputComponents, r.EnvelopeGenus, r.EnvelopeComponents, r.VerticesReached,
+    r.NumberOfActivePoints, r.TopologyRepairs, r.ClearanceUsedRelative, r.TotalSeconds, r.TopologyRepairLog.c_str());
+  ASSERT_EQ(r.State, Status::Ok) << r.Message;
+  // below about twice the default clearance the repair lowers the clearance to 0.001, and three
+  // parts 0.004 apart then stall the simplification above the target (651 of 500 vertices):
+  // topology and the guarantees are asserted there, the count within 1.5 times the target
+  if (gap >= 0.008)
+  {
+    EXPECT_TRUE(r.TargetReached) << r.VerticesReached;
+  }
+  else
+  {
+    EXPECT_LE(r.VerticesReached, 750);
+  }
+  EXPECT_EQ(r.EnvelopeGenus, r.InputGenus);
+  EXPECT_EQ(r.EnvelopeComponents, r.InputComponents);
+  EXPECT_TRUE(r.TopologyWarning.empty()) << r.TopologyWarning;
+  const exact::ExactReport e = exact::exactCheck(m, r.Cage, 0.0);
+  EXPECT_TRUE(e.Closed2Manifold);
+  EXPECT_EQ(e.SelfIntersections, 0);
+  EXPECT_EQ(e.InputIntersections, 0);
+  EXPECT_EQ(e.InputVerticesOutside, 0);
+  EXPECT_EQ(e.CageGenus, r.InputGenus);
+  EXPECT_EQ(e.CageComponents, r.InputComponents);
+}
+
+} // namespace
+
+class GapTopology : public ::testing::TestWithParam<std::tuple<GapShape, double>>
+{
+};
+
+TEST_P(GapTopology, KeptAtDefaults)
+{
+  expectTopologyKept(std::get<0>(GetParam()), std::get<1>(GetParam()));
+}
+
+INSTANTIATE_TEST_SUITE_P(Gaps, GapTopology,
+  ::testing::Combine(::testing::Values(GapShape::Hook, GapShape::Cluster, GapShape::Ring, GapShape::Comb),
+    ::testing::Values(0.004, 0.008, 0.015, 0.03)),
+  [](const ::testing::TestParamInfo<std::tuple<GapShape, double>>& info) {
+    char name[64];
+    std::snprintf(name, sizeof name, "%s_%03d", shapeName(std::get<0>(info.param)),
+      static_cast<int>(std::get<1>(info.param) * 1000 + 0.5));
+    return std::string(name);
+  });
+
+// The strict option: with the repair off, a hook whose tip is 0.004 from its own straight part
+// fuses (a handle appears) and RequireTopology gives no cage; the default keeps a warned cage.
+TEST(GapTopologyStrict, RequireTopologyGivesNoCage)
+{
+  const TriangleMesh m = makeGapShape(GapShape::Hook, 0.004);
+  CageOptions o;
+  o.Envelope.MaximumTopologyRepairs = 0;
+  const CageResult warned = generateCage(PolygonMesh::fromTriangles(m), o);
+  ASSERT_EQ(warned.State, Status::Ok) << warned.Message;
+  EXPECT_NE(warned.EnvelopeGenus, 0);
+  EXPECT_FALSE(warned.TopologyWarning.empty());
+  EXPECT_FALSE(warned.Cage.empty());
+  o.Envelope.RequireTopology = true;
+  const CageResult strict = generateCage(PolygonMesh::fromTriangles(m), o);
+  EXPECT_EQ(strict.State, Status::TopologyChanged);
+  EXPECT_TRUE(strict.Cage.empty());
+  EXPECT_FALSE(strict.Message.empty());
+}
+
+// The facing-gap rule finds the hook's tip and the part below it, which the paper's r/l rule
+// misses (they are close along the surface), and leaves a plain tube inactive.
+TEST(GapRule, FindsTheHookTipOnly)
+{
+  const TriangleMesh world = makeGapShape(GapShape::Hook, 0.008);
+  const Normalization n = Normalization::fit(world);
+  const TriangleMesh hook = n.toUnit(world);
+  ActivePointOptions paper;
+  const ActivePoints a = computeActivePoints(hook, paper);
+  ActivePointOptions gap = paper;
+  gap.GapRatio = 3.0;
+  const ActivePoints b = computeActivePoints(hook, gap);
+  EXPECT_GT(b.NumberOfGapSamples, 0u);
+  EXPECT_GT(b.NumberOfActiveSamples, a.NumberOfActiveSamples);
+  // every gap sample lies near the tip or the part below it (in the shape's own coordinates the
+  // hook's bend spans x in [-0.06, 0.02], y in [-0.02, 0.07]; the straight part runs to x = -1.9)
+  for (int id : b.GapSamples)
+  {
+    const Vec3 p = n.toInput(b.Surface.Points[id]);
+    EXPECT_LT(p.y(), 0.08) << p.transpose();
+    EXPECT_GT(p.x(), -0.15) << p.transpose();
+  }
+  std::vector<Vec3> line{ Vec3(-0.9, 0, 0), Vec3(0.9, 0, 0) };
+  const TriangleMesh tube = makeTube(roundedPolyline(line, 0.02, 0.008), 0.012, 16, Vec3(0, 1, 0));
+  const ActivePoints c = computeActivePoints(tube, gap);
+  EXPECT_EQ(c.NumberOfActiveSamples, 0u);
+}
+
+// Writes the shapes for manual runs: SDFCAGE_WRITE_GAP_SHAPES=folder
+TEST(GapShapes, WriteForManualRuns)
+{
+  const char* dir = std::getenv("SDFCAGE_WRITE_GAP_SHAPES");
+  if (!dir)
+  {
+    GTEST_SKIP() << "set SDFCAGE_WRITE_GAP_SHAPES=folder to write the shapes";
+  }
+  for (GapShape s : { GapShape::Hook, GapShape::Cluster, GapShape::Ring, GapShape::Comb })
+  {
+    for (double gap : { 0.004, 0.008, 0.015, 0.03 })
+    {
+      char name[256];
+      std::snprintf(name, sizeof name, "%s/%s_%.3f.off", dir, shapeName(s), gap);
+      EXPECT_TRUE(exact::writeOFF(name, makeGapShape(s, gap)));
+    }
+  }
+}
