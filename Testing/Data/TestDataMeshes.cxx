@@ -107,7 +107,9 @@ TEST(DataMesh, GenerateCage)
   TriangleMesh input;
   EXPECT_TRUE(exact::fanTriangulate(polygons, input));
   const Normalization& n = result.Normalize;
-  const double delta = n.lengthToInput(options.Envelope.clearance());
+  // the clearance kept: the automatic one, or lowered by the topology repair
+  const double promised = result.ClearanceUsedRelative > 0 ? result.ClearanceUsedRelative : options.Envelope.clearance();
+  const double delta = n.lengthToInput(promised);
   std::cout << "[ data     ] " << name << ": envelope " << result.Envelope.Triangles.size() << " triangles (voxel "
             << result.VoxelSizeUsed << ", removed pockets " << result.RemovedPockets << "); cage "
             << result.VerticesReached << " vertices, " << result.Cage.Triangles.size() << " triangles (simplification "
@@ -133,7 +135,7 @@ TEST(DataMesh, GenerateCage)
     const std::string what = name + " " + checks[k].What;
     std::cout << "[ data     ] " << what << ": exact " << exact::toJson(r) << "\n"
               << "[ data     ] " << what << ": clearance " << n.lengthToUnit(r.MinimumClearance)
-              << " unit-sphere units (promised " << options.Envelope.clearance() << ")\n"
+              << " unit-sphere units (promised " << promised << ")\n"
               << "[ data     ] " << what << ": input genus " << result.Defects.Genus << ", components "
               << result.Defects.Components << "; " << checks[k].What << " genus " << r.CageGenus << ", components "
               << r.CageComponents
@@ -194,7 +196,7 @@ TEST(DataMesh, GenerateCage)
   // The optimization (paper §3.3, MIPS, one round) of this cage keeps every guarantee and lowers
   // its energy; judged by the same referee.
   OptimizeOptions oo;
-  oo.Clearance = options.Envelope.clearance();
+  oo.Clearance = promised;
   const OptimizeResult opt = optimizeCageInInputUnits(result.Cage, input, oo);
   ASSERT_EQ(opt.State, Status::Ok) << opt.Message;
   EXPECT_FALSE(opt.Reverted) << opt.Message;
