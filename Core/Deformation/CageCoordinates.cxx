@@ -103,17 +103,20 @@ struct RowScratch
 {
   std::vector<Vec3> A;      // v_i - x
   std::vector<double> R;    // |v_i - x|
+  std::vector<double> InvR; // 1 / |v_i - x| (MVC)
   std::vector<Vec3> U;      // unit vectors (MVC)
-  std::vector<double> Theta, SinTheta, CosTheta; // per edge (MVC)
+  std::vector<double> Theta, SinHalf, CosHalf, InvSin; // per edge (MVC): angle at x, sin, cos of half, 1/sin
   std::vector<double> F;    // per edge line integral of 1/R (Green)
   void resize(std::size_t nv, std::size_t ne)
   {
     this->A.resize(nv);
     this->R.resize(nv);
+    this->InvR.resize(nv);
     this->U.resize(nv);
     this->Theta.resize(ne);
-    this->SinTheta.resize(ne);
-    this->CosTheta.resize(ne);
+    this->SinHalf.resize(ne);
+    this->CosHalf.resize(ne);
+    this->InvSin.resize(ne);
     this->F.resize(ne);
   }
 };
@@ -124,8 +127,98 @@ struct RowInfo
   double Winding = 0.0;
 };
 
+/// atan(y / x) for 0 <= y, 0 <= x, not both 0: in [0, pi/2], with an argument <= 1 (std::atan of
+/// a quotient is about twice as fast as std::atan2 here).
+inline double angleOfQuadrant1(double y, double x)
+{
+  constexpr double HalfPi = 0.5 * Pi;
+  return y <= x ? std::atan(y / x) : HalfPi - std::atan(x / y);
+}
+
+/// 2 atan2(y, x) (a solid angle from Van Oosterom and Strackee's half-angle formula), in (-2 pi, 2 pi].
+inline double twiceAtan2(double y, double x)
+{
+  if (x > 0.0)
+  {
+    return 2.0 * std::atan(y / x);
+  }
+  if (x < 0.0)
+  {
+    return 2.0 * (std::atan(y / x) + (y >= 0.0 ? Pi : -Pi));
+  }
+  return y > 0.0 ? Pi : (y < 0.0 ? -Pi : 0.0);
+}
+
+/// Winding number of the cage at x (relative vertex positions s.A) by the exact solid angles.
+double windingBySolidAngles(const CageFrame& cage, const RowScratch& s)
+{
+  double sum = 0.0;
+  for (const Triangle& t : cage.Mesh.Triangles)
+  {
+    const Vec3 &a0 = s.A[t[0]], &a1 = s.A[t[1]], &a2 = s.A[t[2]];
+    const double r0 = s.R[t[0]], r1 = s.R[t[1]], r2 = s.R[t[2]];
+    sum += twiceAtan2(a0.dot(a1.cross(a2)), r0 * r1 * r2 + a0.dot(a1) * r2 + a1.dot(a2) * r0 + a2.dot(a0) * r1);
+  }
+  return sum * InvFourPi;
+}
+
+/// Inside (winding 1) or outside (0) by the parity of a ray's crossings (Moeller-Trumbore); a
+/// crossing within 1e-9 of a triangle's edge, or a ray grazing a plane, falls back to the exact
+/// solid-angle sum. For the mean value mode's count of outside points (Green mode has the exact
+/// winding number from its own solid angles).
+double windingByRay(const CageFrame& cage, const RowScratch& s)
+{
+  const Vec3 d = Vec3(0.2357022603955158, 0.5491251384243406, 0.8017837257372732).normalized();
+  int crossings = 0;
+  for (const Triangle& t : cage.Mesh.Triangles)
+  {
+    const Vec3& a0 = s.A[t[0]];
+    const Vec3 e1 = s.A[t[1]] - a0, e2 = s.A[t[2]] - a0;
+    const Vec3 pv = d.cross(e2);
+    const double det = e1.dot(pv);
+    const double scale = e1.squaredNorm() + e2.squaredNorm(); // >= |e1| |e2|, no square root
+    const Vec3 tv = -a0;
+    if (std::abs(det) <= 1e-12 * scale)
+    {
+      // the ray is parallel to the plane: no crossing unless it runs in the plane
+      if (std::abs(tv.dot(e1.cross(e2))) <= 1e-12 * scale * tv.norm())
+      {
+        return windingBySolidAngles(cage, s);
+      }
+      continue;
+    }
+    const double inv = 1.0 / det;
+    const double u = tv.dot(pv) * inv;
+    if (u < -1e-9 || u > 1.0 + 1e-9)
+    {
+      continue;
+    }
+    const Vec3 qv = tv.cross(e1);
+    const double v = d.dot(qv) * inv;
+    if (v < -1e-9 || u + v > 1.0 + 1e-9)
+    {
+      continue;
+    }
+    const double along = e2.dot(qv) * inv;
+    if (along <= 0.0)
+    {
+      continue;
+    }
+    if (u < 1e-9 || v < 1e-9 || u + v > 1.0 - 1e-9)
+    {
+      return windingBySolidAngles(cage, s); // through an edge or a vertex: decide exactly
+    }
+    ++crossings;
+  }
+  return (crossings % 2) ? 1.0 : 0.0;
+}
+
 /// Mean value coordinates of x (Ju, Schaefer, Warren 2005, the robust pseudo-code of §3.3) into
-/// row[0 .. #V). Also the winding number of the cage at x.
+/// row[0 .. #V). Also whether x is inside the cage (Winding 1 or 0, see windingByRay).
+/// The paper's per-triangle sines and cosines are taken from half angles: theta_e = 2 alpha_e with
+/// sin(alpha_e) = |u_a - u_b| / 2, cos(alpha_e) = |u_a + u_b| / 2 per edge, and
+/// h = alpha_0 + alpha_1 + alpha_2 by the addition theorems (one arctangent per edge, none per
+/// triangle).
 RowInfo meanValueRow(const CageFrame& cage, const Vec3& x, double* row, RowScratch& s)
 {
   RowInfo info;
@@ -143,43 +236,58 @@ RowInfo meanValueRow(const CageFrame& cage, const Vec3& x, double* row, RowScrat
       info.Winding = 0.5;
       return info;
     }
-    s.U[i] = s.A[i] / s.R[i];
+    s.InvR[i] = 1.0 / s.R[i];
+    s.U[i] = s.A[i] * s.InvR[i];
   }
   for (std::size_t e = 0; e < cage.Edges.size(); ++e)
   {
-    // theta = 2 asin(l / 2) with l = |u_a - u_b|, written as 2 atan2(l, m) with m = |u_a + u_b|
-    // (l^2 + m^2 = 4): well conditioned up to theta = pi, where asin loses half the digits
-    const double l = (s.U[cage.Edges[e][0]] - s.U[cage.Edges[e][1]]).norm();
-    const double m = (s.U[cage.Edges[e][0]] + s.U[cage.Edges[e][1]]).norm();
-    s.Theta[e] = 2.0 * std::atan2(l, m);
-    s.SinTheta[e] = 0.5 * l * m;
-    s.CosTheta[e] = 0.25 * (m * m - l * l);
+    // l = |u_a - u_b| = 2 sin(alpha), m = |u_a + u_b| = 2 cos(alpha), l^2 + m^2 = 4: take the
+    // smaller one from its own difference or sum, the other from 4 - x^2 (no cancellation)
+    const Vec3& ua = s.U[cage.Edges[e][0]];
+    const Vec3& ub = s.U[cage.Edges[e][1]];
+    double l2 = (ua - ub).squaredNorm();
+    double l, m;
+    if (l2 <= 2.0)
+    {
+      l = std::sqrt(l2);
+      m = std::sqrt(std::max(0.0, 4.0 - l2));
+    }
+    else
+    {
+      const double m2 = (ua + ub).squaredNorm();
+      m = std::sqrt(m2);
+      l = std::sqrt(std::max(0.0, 4.0 - m2));
+    }
+    const double alpha = angleOfQuadrant1(l, m);
+    s.Theta[e] = 2.0 * alpha;
+    s.SinHalf[e] = 0.5 * l;
+    s.CosHalf[e] = 0.5 * m;
+    const double sinTheta = 0.5 * l * m;
+    s.InvSin[e] = sinTheta > 1e-12 ? 1.0 / sinTheta : 0.0; // 0: x on the line of the edge
   }
-  double windingSum = 0.0;
   for (std::size_t j = 0; j < cage.Mesh.Triangles.size(); ++j)
   {
     const Triangle& t = cage.Mesh.Triangles[j];
-    // theta[k]: the angle at x of the edge opposite corner k = edge (k+1, k+2)
-    double th[3], sn[3], cs[3];
+    // corner k sees the edge opposite it, (k+1, k+2)
+    int e[3];
     for (int k = 0; k < 3; ++k)
     {
-      const int e = cage.FaceEdges[j][(k + 1) % 3];
-      th[k] = s.Theta[e];
-      sn[k] = s.SinTheta[e];
-      cs[k] = s.CosTheta[e];
+      e[k] = cage.FaceEdges[j][(k + 1) % 3];
     }
-    const double det = s.U[t[0]].dot(s.U[t[1]].cross(s.U[t[2]]));
-    windingSum += 2.0 * std::atan2(det, 1.0 + cs[0] + cs[1] + cs[2]);
-    const double h = 0.5 * (th[0] + th[1] + th[2]);
-    if (Pi - h < 1e-10)
+    // h = alpha_0 + alpha_1 + alpha_2 (half the sum of the angles)
+    const double s01 = s.SinHalf[e[0]] * s.CosHalf[e[1]] + s.CosHalf[e[0]] * s.SinHalf[e[1]];
+    const double c01 = s.CosHalf[e[0]] * s.CosHalf[e[1]] - s.SinHalf[e[0]] * s.SinHalf[e[1]];
+    const double sinH = s01 * s.CosHalf[e[2]] + c01 * s.SinHalf[e[2]];
+    const double cosH = c01 * s.CosHalf[e[2]] - s01 * s.SinHalf[e[2]];
+    if (sinH < 1e-10 && cosH < 0.0)
     {
-      // x lies on this triangle: linear interpolation of its corners (2D barycentric weights)
+      // h = pi: x lies on this triangle: linear interpolation of its corners (2D barycentric)
       std::fill(row, row + nv, 0.0);
-      double sum = 0.0;
-      double w[3];
+      double w[3], sum = 0.0;
       for (int k = 0; k < 3; ++k)
       {
-        w[k] = sn[k] * s.R[t[(k + 1) % 3]] * s.R[t[(k + 2) % 3]];
+        const double sinTheta = 2.0 * s.SinHalf[e[k]] * s.CosHalf[e[k]];
+        w[k] = sinTheta * s.R[t[(k + 1) % 3]] * s.R[t[(k + 2) % 3]];
         sum += w[k];
       }
       for (int k = 0; k < 3; ++k)
@@ -190,19 +298,20 @@ RowInfo meanValueRow(const CageFrame& cage, const Vec3& x, double* row, RowScrat
       info.Winding = 0.5;
       return info;
     }
-    if (sn[0] < 1e-12 || sn[1] < 1e-12 || sn[2] < 1e-12)
+    if (s.InvSin[e[0]] == 0.0 || s.InvSin[e[1]] == 0.0 || s.InvSin[e[2]] == 0.0)
     {
       continue; // x on the line of an edge, outside the triangle: its plane holds x
     }
-    const double sinH = std::sin(h), cosH = std::cos(h);
+    const double det = s.U[t[0]].dot(s.U[t[1]].cross(s.U[t[2]]));
     const double sign = det < 0.0 ? -1.0 : 1.0;
     double c[3], sk[3];
     bool flat = false;
     for (int k = 0; k < 3; ++k)
     {
-      const double sinHMinusTheta = sinH * cs[k] - cosH * sn[k];
-      c[k] = 2.0 * sinH * sinHMinusTheta / (sn[(k + 1) % 3] * sn[(k + 2) % 3]) - 1.0;
-      sk[k] = sign * std::sqrt(std::max(0.0, 1.0 - c[k] * c[k]));
+      const double sinTheta = 2.0 * s.SinHalf[e[k]] * s.CosHalf[e[k]];
+      const double cosTheta = s.CosHalf[e[k]] * s.CosHalf[e[k]] - s.SinHalf[e[k]] * s.SinHalf[e[k]];
+      c[k] = 2.0 * sinH * (sinH * cosTheta - cosH * sinTheta) * s.InvSin[e[(k + 1) % 3]] * s.InvSin[e[(k + 2) % 3]] - 1.0;
+      sk[k] = sign * std::sqrt(std::max(0.0, (1.0 - c[k]) * (1.0 + c[k])));
       flat = flat || std::abs(sk[k]) <= 1e-10;
     }
     if (flat)
@@ -212,7 +321,8 @@ RowInfo meanValueRow(const CageFrame& cage, const Vec3& x, double* row, RowScrat
     for (int k = 0; k < 3; ++k)
     {
       const int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
-      row[t[k]] += (th[k] - c[k1] * th[k2] - c[k2] * th[k1]) / (s.R[t[k]] * sn[k1] * sk[k2]);
+      const double th = s.Theta[e[k]], th1 = s.Theta[e[k1]], th2 = s.Theta[e[k2]];
+      row[t[k]] += (th - c[k1] * th2 - c[k2] * th1) * s.InvR[t[k]] * s.InvSin[e[k1]] / sk[k2];
     }
   }
   double sum = 0.0;
@@ -220,11 +330,12 @@ RowInfo meanValueRow(const CageFrame& cage, const Vec3& x, double* row, RowScrat
   {
     sum += row[i];
   }
+  const double inv = 1.0 / sum;
   for (std::size_t i = 0; i < nv; ++i)
   {
-    row[i] /= sum;
+    row[i] *= inv;
   }
-  info.Winding = windingSum * InvFourPi;
+  info.Winding = windingByRay(cage, s);
   return info;
 }
 
@@ -285,7 +396,7 @@ RowInfo greenRow(const CageFrame& cage, const Vec3& x, double* row, RowScratch& 
     const double r0 = s.R[t[0]], r1 = s.R[t[1]], r2 = s.R[t[2]];
     const double det = a0.dot(a1.cross(a2));
     const double den = r0 * r1 * r2 + a0.dot(a1) * r2 + a1.dot(a2) * r0 + a2.dot(a0) * r1;
-    const double omega = 2.0 * std::atan2(det, den); // > 0 seen from behind the triangle
+    const double omega = twiceAtan2(det, den); // > 0 seen from behind the triangle
     const double h = -cage.Normal[j].dot(a0);         // height of x over the plane
     if (std::abs(h) <= cage.Tiny && den <= 0.0)
     {
@@ -632,18 +743,16 @@ bool CageDeformer::apply(const std::vector<Vec3>& deformedCagePoints, std::vecto
   const Eigen::Index n = d.Weights.rows();
   out.resize(static_cast<std::size_t>(n));
   ThreadLimit limit(numberOfThreads);
-  // Row blocks of the product on every thread (each block one small GEMM).
-  const Eigen::Index block = 256;
-  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, (n + block - 1) / block), [&](const tbb::blocked_range<Eigen::Index>& r) {
-    for (Eigen::Index blk = r.begin(); blk != r.end(); ++blk)
+  // One pass over the weights, row by row: three dot products per row (the row stays in the
+  // first-level cache for the second and third), the columns of b contiguous. Memory bound: the
+  // weights are read once per apply.
+  const Eigen::Matrix<double, Eigen::Dynamic, 3> columns = b; // column-major copy
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, n, 512), [&](const tbb::blocked_range<Eigen::Index>& r) {
+    for (Eigen::Index i = r.begin(); i != r.end(); ++i)
     {
-      const Eigen::Index first = blk * block;
-      const Eigen::Index count = std::min(block, n - first);
-      const Eigen::Matrix<double, Eigen::Dynamic, 3, Eigen::RowMajor> y = d.Weights.middleRows(first, count) * b;
-      for (Eigen::Index i = 0; i < count; ++i)
-      {
-        out[static_cast<std::size_t>(first + i)] = y.row(i).transpose();
-      }
+      const auto row = d.Weights.row(i);
+      out[static_cast<std::size_t>(i)] =
+        Vec3(row.dot(columns.col(0).transpose()), row.dot(columns.col(1).transpose()), row.dot(columns.col(2).transpose()));
     }
   });
   return true;
