@@ -559,6 +559,7 @@ struct CageDeformer::Data
   CageFrame Cage;
   WeightMatrix Weights;
   std::vector<char> Green;
+  std::vector<CageDeformer::Location> Where;
   bool Bound = false;
 };
 
@@ -641,6 +642,7 @@ CageBindingResult CageDeformer::bind(const TriangleMesh& restCage, const std::ve
   {
     d.Weights.resize(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(columns));
     d.Green.assign(n, 0);
+    d.Where.assign(n, Location::Inside);
   }
   catch (const std::bad_alloc&)
   {
@@ -695,10 +697,12 @@ CageBindingResult CageDeformer::bind(const TriangleMesh& restCage, const std::ve
         if (info.OnCage)
         {
           ++onCage;
+          d.Where[p] = Location::OnCage;
         }
         else if (info.Winding < 0.5)
         {
           ++outside;
+          d.Where[p] = Location::Outside;
         }
       }
       const long long finished = done.fetch_add(static_cast<long long>(range.size())) + static_cast<long long>(range.size());
@@ -767,6 +771,11 @@ std::vector<double> CageDeformer::weights(std::size_t p) const
 bool CageDeformer::usesGreen(std::size_t p) const
 {
   return this->D->Green[p] != 0;
+}
+
+CageDeformer::Location CageDeformer::location(std::size_t p) const
+{
+  return this->D->Where[p];
 }
 
 } // namespace sdfcage

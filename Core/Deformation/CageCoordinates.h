@@ -122,6 +122,15 @@ public:
   /// True when point p uses Green coordinates (false: mean value, see the header comment).
   bool usesGreen(std::size_t p) const;
 
+  /// Where point p lies with respect to the rest cage.
+  enum class Location : unsigned char
+  {
+    Inside = 0,
+    Outside = 1,
+    OnCage = 2
+  };
+  Location location(std::size_t p) const;
+
 private:
   struct Data;
   std::unique_ptr<Data> D;
