@@ -35,6 +35,7 @@ struct CageFrame
   TriangleMesh Mesh;
   std::vector<std::array<int, 2>> Edges;      // unique undirected edges
   std::vector<std::array<int, 3>> FaceEdges;  // edge of corners (k, k+1)
+  std::vector<std::array<double, 3>> FaceEdgeSign; // +1 when edge (k, k+1) runs from Edges[e][0] to [1]
   std::vector<Vec3> EdgeTangent;              // unit, from Edges[e][0] to Edges[e][1]
   std::vector<Vec3> Normal;                   // unit outward normal per triangle
   std::vector<std::array<Vec3, 3>> Gradient;  // in-plane gradient of each corner's hat function
@@ -43,6 +44,92 @@ struct CageFrame
   double Diagonal = 0.0;
   double Tiny = 0.0; // lengths below this count as zero (1e-12 x the diagonal)
 
+  // The inside test's ray direction and a grid of the triangles projected along it (the plane
+  // spanned by RayU, RayV): a ray from x meets only the triangles of x's cell.
+  Vec3 Ray = Vec3(0.2357022603955158, 0.5491251384243406, 0.8017837257372732).normalized();
+  Vec3 RayU, RayV;
+  double GridLo[2] = { 0.0, 0.0 }, GridStep[2] = { 1.0, 1.0 };
+  int GridSize = 1;
+  std::vector<int> CellStart, CellTriangles; // compressed: cell c has CellTriangles[CellStart[c] .. CellStart[c+1])
+
+  void buildRayGrid()
+  {
+    this->RayU = this->Ray.unitOrthogonal();
+    this->RayV = this->Ray.cross(this->RayU);
+    const auto& P = this->Mesh.Points;
+    double lo[2] = { 1e300, 1e300 }, hi[2] = { -1e300, -1e300 };
+    for (const Vec3& p : P)
+    {
+      const double c[2] = { p.dot(this->RayU), p.dot(this->RayV) };
+      for (int a = 0; a < 2; ++a)
+      {
+        lo[a] = std::min(lo[a], c[a]);
+        hi[a] = std::max(hi[a], c[a]);
+      }
+    }
+    const std::size_t nf = this->Mesh.Triangles.size();
+    this->GridSize = std::max(1, static_cast<int>(std::sqrt(static_cast<double>(nf))));
+    for (int a = 0; a < 2; ++a)
+    {
+      const double pad = 1e-9 * (hi[a] - lo[a]) + 1e-300;
+      this->GridLo[a] = lo[a] - pad;
+      this->GridStep[a] = (hi[a] - lo[a] + 2.0 * pad) / this->GridSize;
+    }
+    const int g = this->GridSize;
+    std::vector<std::array<int, 4>> ranges(nf);
+    std::vector<int> count(static_cast<std::size_t>(g) * g + 1, 0);
+    for (std::size_t j = 0; j < nf; ++j)
+    {
+      double tlo[2] = { 1e300, 1e300 }, thi[2] = { -1e300, -1e300 };
+      for (int k = 0; k < 3; ++k)
+      {
+        const Vec3& p = P[this->Mesh.Triangles[j][k]];
+        const double c[2] = { p.dot(this->RayU), p.dot(this->RayV) };
+        for (int a = 0; a < 2; ++a)
+        {
+          tlo[a] = std::min(tlo[a], c[a]);
+          thi[a] = std::max(thi[a], c[a]);
+        }
+      }
+      // one cell of margin on each side: the inside test's tolerance never misses a triangle
+      auto& r = ranges[j];
+      r[0] = std::max(0, this->cellOf(tlo[0], 0) - 1);
+      r[1] = std::min(g - 1, this->cellOf(thi[0], 0) + 1);
+      r[2] = std::max(0, this->cellOf(tlo[1], 1) - 1);
+      r[3] = std::min(g - 1, this->cellOf(thi[1], 1) + 1);
+      for (int i = r[0]; i <= r[1]; ++i)
+      {
+        for (int k = r[2]; k <= r[3]; ++k)
+        {
+          ++count[static_cast<std::size_t>(i) * g + k + 1];
+        }
+      }
+    }
+    for (std::size_t c = 1; c < count.size(); ++c)
+    {
+      count[c] += count[c - 1];
+    }
+    this->CellStart = count;
+    this->CellTriangles.assign(static_cast<std::size_t>(count.back()), 0);
+    for (std::size_t j = 0; j < nf; ++j)
+    {
+      const auto& r = ranges[j];
+      for (int i = r[0]; i <= r[1]; ++i)
+      {
+        for (int k = r[2]; k <= r[3]; ++k)
+        {
+          this->CellTriangles[static_cast<std::size_t>(count[static_cast<std::size_t>(i) * g + k]++)] = static_cast<int>(j);
+        }
+      }
+    }
+  }
+
+  /// Grid cell index along axis a (may be outside [0, GridSize)).
+  int cellOf(double c, int a) const
+  {
+    return static_cast<int>(std::floor((c - this->GridLo[a]) / this->GridStep[a]));
+  }
+
   void build(const TriangleMesh& cage)
   {
     this->Mesh = cage;
@@ -50,6 +137,7 @@ struct CageFrame
     const std::size_t nf = this->Mesh.Triangles.size();
     std::map<std::pair<int, int>, int> edgeIds;
     this->FaceEdges.resize(nf);
+    this->FaceEdgeSign.resize(nf);
     for (std::size_t j = 0; j < nf; ++j)
     {
       const Triangle& t = this->Mesh.Triangles[j];
@@ -64,6 +152,7 @@ struct CageFrame
           this->Edges.push_back({ key.first, key.second });
         }
         this->FaceEdges[j][k] = it->second;
+        this->FaceEdgeSign[j][k] = a < b ? 1.0 : -1.0;
       }
     }
     this->EdgeTangent.resize(this->Edges.size());
@@ -95,6 +184,7 @@ struct CageFrame
     const auto box = bounds(this->Mesh);
     this->Diagonal = (box[1] - box[0]).norm();
     this->Tiny = 1e-12 * this->Diagonal;
+    this->buildRayGrid();
   }
 };
 
@@ -106,6 +196,7 @@ struct RowScratch
   std::vector<double> InvR; // 1 / |v_i - x| (MVC)
   std::vector<Vec3> U;      // unit vectors (MVC)
   std::vector<double> Theta, SinHalf, CosHalf, InvSin; // per edge (MVC): angle at x, sin, cos of half, 1/sin
+  std::vector<Vec3> EdgeNormal;                        // per edge (MVC): unit normal of the plane (x, edge)
   std::vector<double> F;    // per edge line integral of 1/R (Green)
   void resize(std::size_t nv, std::size_t ne)
   {
@@ -117,6 +208,7 @@ struct RowScratch
     this->SinHalf.resize(ne);
     this->CosHalf.resize(ne);
     this->InvSin.resize(ne);
+    this->EdgeNormal.resize(ne);
     this->F.resize(ne);
   }
 };
@@ -166,12 +258,19 @@ double windingBySolidAngles(const CageFrame& cage, const RowScratch& s)
 /// crossing within 1e-9 of a triangle's edge, or a ray grazing a plane, falls back to the exact
 /// solid-angle sum. For the mean value mode's count of outside points (Green mode has the exact
 /// winding number from its own solid angles).
-double windingByRay(const CageFrame& cage, const RowScratch& s)
+double windingByRay(const CageFrame& cage, const RowScratch& s, const Vec3& x)
 {
-  const Vec3 d = Vec3(0.2357022603955158, 0.5491251384243406, 0.8017837257372732).normalized();
-  int crossings = 0;
-  for (const Triangle& t : cage.Mesh.Triangles)
+  const Vec3& d = cage.Ray;
+  const int ci = cage.cellOf(x.dot(cage.RayU), 0), ck = cage.cellOf(x.dot(cage.RayV), 1);
+  if (ci < 0 || ck < 0 || ci >= cage.GridSize || ck >= cage.GridSize)
   {
+    return 0.0; // the ray misses the cage's shadow: outside
+  }
+  const std::size_t cell = static_cast<std::size_t>(ci) * cage.GridSize + ck;
+  int crossings = 0;
+  for (int c = cage.CellStart[cell]; c < cage.CellStart[cell + 1]; ++c)
+  {
+    const Triangle& t = cage.Mesh.Triangles[static_cast<std::size_t>(cage.CellTriangles[static_cast<std::size_t>(c)])];
     const Vec3& a0 = s.A[t[0]];
     const Vec3 e1 = s.A[t[1]] - a0, e2 = s.A[t[2]] - a0;
     const Vec3 pv = d.cross(e2);
@@ -264,6 +363,7 @@ RowInfo meanValueRow(const CageFrame& cage, const Vec3& x, double* row, RowScrat
     s.CosHalf[e] = 0.5 * m;
     const double sinTheta = 0.5 * l * m;
     s.InvSin[e] = sinTheta > 1e-12 ? 1.0 / sinTheta : 0.0; // 0: x on the line of the edge
+    s.EdgeNormal[e] = ua.cross(ub) * s.InvSin[e];          // |u_a x u_b| = sin(theta)
   }
   for (std::size_t j = 0; j < cage.Mesh.Triangles.size(); ++j)
   {
@@ -303,6 +403,33 @@ RowInfo meanValueRow(const CageFrame& cage, const Vec3& x, double* row, RowScrat
       continue; // x on the line of an edge, outside the triangle: its plane holds x
     }
     const double det = s.U[t[0]].dot(s.U[t[1]].cross(s.U[t[2]]));
+    {
+      // The paper's vector form (§3.2): with n_k the unit normal of the plane through x and the
+      // edge opposite corner k (oriented as u_{k+1} x u_{k+2}) and the mean vector
+      // m = sum_k theta_k / 2 n_k, w_k = (n_k . m) / (n_k . u_k) / d_k, where
+      // n_k . u_k = det(u_0, u_1, u_2) / sin(theta_k). Used where x is clearly off the plane of
+      // the triangle (sine of its elevation over the planes >= 1e-3); the robust angle form
+      // below near the plane, where the vector form loses digits.
+      const double sin0 = 2.0 * s.SinHalf[e[0]] * s.CosHalf[e[0]];
+      const double sin1 = 2.0 * s.SinHalf[e[1]] * s.CosHalf[e[1]];
+      const double sin2 = 2.0 * s.SinHalf[e[2]] * s.CosHalf[e[2]];
+      const double largest = std::max(sin0, std::max(sin1, sin2));
+      if (std::abs(det) >= 1e-3 * largest)
+      {
+        Vec3 n[3];
+        for (int k = 0; k < 3; ++k)
+        {
+          n[k] = cage.FaceEdgeSign[j][(k + 1) % 3] * s.EdgeNormal[e[k]];
+        }
+        // (twice the paper's m: the robust form below is scaled so, and the two must agree)
+        const Vec3 m = s.Theta[e[0]] * n[0] + s.Theta[e[1]] * n[1] + s.Theta[e[2]] * n[2];
+        const double invDet = 1.0 / det;
+        row[t[0]] += n[0].dot(m) * sin0 * invDet * s.InvR[t[0]];
+        row[t[1]] += n[1].dot(m) * sin1 * invDet * s.InvR[t[1]];
+        row[t[2]] += n[2].dot(m) * sin2 * invDet * s.InvR[t[2]];
+        continue;
+      }
+    }
     const double sign = det < 0.0 ? -1.0 : 1.0;
     double c[3], sk[3];
     bool flat = false;
@@ -335,7 +462,7 @@ RowInfo meanValueRow(const CageFrame& cage, const Vec3& x, double* row, RowScrat
   {
     row[i] *= inv;
   }
-  info.Winding = windingByRay(cage, s);
+  info.Winding = windingByRay(cage, s, x);
   return info;
 }
 

@@ -424,3 +424,59 @@ TEST(CageCoordinates, GreenStretchFactor)
     EXPECT_NEAR(big[j].norm(), 2.5, 1e-14);
   }
 }
+
+TEST(CageCoordinates, InsideTestsAgree)
+{
+  // mean value mode decides inside/outside by a ray's crossings over a projected grid, Green mode
+  // by the exact solid-angle sum: they must agree point by point (random points around a torus
+  // cage, and points on the grid box's lattice, where rays graze edges)
+  const TorusCase c;
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(-1.7, 1.7), w(-0.7, 0.7);
+  std::vector<Vec3> points;
+  for (int i = 0; i < 3000; ++i)
+  {
+    points.emplace_back(u(rng), u(rng), w(rng));
+  }
+  CageDeformer mvc, green;
+  CageCoordinateOptions o;
+  ASSERT_EQ(mvc.bind(c.Cage, points, o).State, Status::Ok);
+  o.Kind = CageCoordinateKind::Green;
+  ASSERT_EQ(green.bind(c.Cage, points, o).State, Status::Ok);
+  int outside = 0, inside = 0;
+  for (std::size_t i = 0; i < points.size(); ++i)
+  {
+    ASSERT_EQ(mvc.location(i), green.location(i)) << i;
+    const double wn = windingNumber(c.Cage, points[i]);
+    EXPECT_EQ(mvc.location(i) == CageDeformer::Location::Inside, wn > 0.5) << i;
+    (wn > 0.5 ? inside : outside)++;
+  }
+  EXPECT_GT(inside, 300);
+  EXPECT_GT(outside, 300);
+
+  const TriangleMesh box = makeGridBox(Vec3(0, 0, 0), Vec3(4, 2, 2), { 4, 2, 2 });
+  std::vector<Vec3> lattice;
+  for (int i = -1; i <= 9; ++i)
+  {
+    for (int j = -1; j <= 5; ++j)
+    {
+      for (int k = -1; k <= 5; ++k)
+      {
+        const Vec3 p(0.5 * i + 0.25, 0.5 * j + 0.25, 0.5 * k + 0.25);
+        lattice.push_back(p);
+      }
+    }
+  }
+  CageDeformer onLattice;
+  const CageBindingResult r = onLattice.bind(box, lattice, {});
+  ASSERT_EQ(r.State, Status::Ok);
+  long long expectedOutside = 0;
+  for (std::size_t i = 0; i < lattice.size(); ++i)
+  {
+    const Vec3& p = lattice[i];
+    const bool in = p.x() > 0 && p.x() < 4 && p.y() > 0 && p.y() < 2 && p.z() > 0 && p.z() < 2;
+    expectedOutside += in ? 0 : 1;
+    EXPECT_EQ(onLattice.location(i) == CageDeformer::Location::Inside, in) << p.transpose();
+  }
+  EXPECT_EQ(r.PointsOutside, expectedOutside);
+}
