@@ -2,6 +2,7 @@
 #include "Deformation/CageCoordinates.h"
 
 #include "Common/Threads.h"
+#include "Deformation/VectorMath.h"
 
 #include <Eigen/Core>
 
@@ -198,8 +199,14 @@ struct RowScratch
   std::vector<double> Theta, SinHalf, CosHalf, InvSin; // per edge (MVC): angle at x, sin, cos of half, 1/sin
   std::vector<Vec3> EdgeNormal;                        // per edge (MVC): unit normal of the plane (x, edge)
   std::vector<double> F;    // per edge line integral of 1/R (Green)
-  void resize(std::size_t nv, std::size_t ne)
+  std::vector<double> In, Out; // arguments and values of the vector log / atan
+  std::vector<double> Det, Den; // per triangle (Green): the solid angle's half-angle tangent
+  void resize(std::size_t nv, std::size_t ne, std::size_t nf)
   {
+    this->In.resize(std::max(ne, nf));
+    this->Out.resize(std::max(ne, nf));
+    this->Det.resize(nf);
+    this->Den.resize(nf);
     this->A.resize(nv);
     this->R.resize(nv);
     this->InvR.resize(nv);
@@ -218,14 +225,6 @@ struct RowInfo
   bool OnCage = false;
   double Winding = 0.0;
 };
-
-/// atan(y / x) for 0 <= y, 0 <= x, not both 0: in [0, pi/2], with an argument <= 1 (std::atan of
-/// a quotient is about twice as fast as std::atan2 here).
-inline double angleOfQuadrant1(double y, double x)
-{
-  constexpr double HalfPi = 0.5 * Pi;
-  return y <= x ? std::atan(y / x) : HalfPi - std::atan(x / y);
-}
 
 /// 2 atan2(y, x) (a solid angle from Van Oosterom and Strackee's half-angle formula), in (-2 pi, 2 pi].
 inline double twiceAtan2(double y, double x)
@@ -357,13 +356,17 @@ RowInfo meanValueRow(const CageFrame& cage, const Vec3& x, double* row, RowScrat
       m = std::sqrt(m2);
       l = std::sqrt(std::max(0.0, 4.0 - m2));
     }
-    const double alpha = angleOfQuadrant1(l, m);
-    s.Theta[e] = 2.0 * alpha;
+    s.In[e] = l <= m ? l / m : m / l; // alpha = atan(l / m), from an argument <= 1 (l^2 + m^2 = 4)
     s.SinHalf[e] = 0.5 * l;
     s.CosHalf[e] = 0.5 * m;
     const double sinTheta = 0.5 * l * m;
     s.InvSin[e] = sinTheta > 1e-12 ? 1.0 / sinTheta : 0.0; // 0: x on the line of the edge
     s.EdgeNormal[e] = ua.cross(ub) * s.InvSin[e];          // |u_a x u_b| = sin(theta)
+  }
+  vectorAtan(s.In.data(), s.Out.data(), static_cast<int>(cage.Edges.size()));
+  for (std::size_t e = 0; e < cage.Edges.size(); ++e)
+  {
+    s.Theta[e] = 2.0 * (s.SinHalf[e] <= s.CosHalf[e] ? s.Out[e] : 0.5 * Pi - s.Out[e]);
   }
   for (std::size_t j = 0; j < cage.Mesh.Triangles.size(); ++j)
   {
@@ -495,15 +498,15 @@ RowInfo greenRow(const CageFrame& cage, const Vec3& x, double* row, RowScratch& 
     // (sb - sa = the edge length > 0)
     if (sa >= 0.0)
     {
-      s.F[e] = std::log((s.R[b] + sb) / (s.R[a] + sa));
+      s.In[e] = (s.R[b] + sb) / (s.R[a] + sa);
     }
     else if (sb <= 0.0)
     {
-      s.F[e] = std::log((s.R[a] - sa) / (s.R[b] - sb));
+      s.In[e] = (s.R[a] - sa) / (s.R[b] - sb);
     }
     else if (d2 > cage.Tiny * cage.Tiny)
     {
-      s.F[e] = std::log((s.R[b] + sb) * (s.R[a] - sa) / d2);
+      s.In[e] = (s.R[b] + sb) * (s.R[a] - sa) / d2;
     }
     else
     {
@@ -511,9 +514,8 @@ RowInfo greenRow(const CageFrame& cage, const Vec3& x, double* row, RowScratch& 
       return info;
     }
   }
-  double windingSum = 0.0;
-  double* phi = row;
-  double* psi = row + nv;
+  vectorLog(s.In.data(), s.F.data(), static_cast<int>(cage.Edges.size()));
+  // the solid angles omega = 2 atan2(det, den) (Van Oosterom and Strackee), arctangents at once
   for (std::size_t j = 0; j < nf; ++j)
   {
     const Triangle& t = cage.Mesh.Triangles[j];
@@ -523,13 +525,30 @@ RowInfo greenRow(const CageFrame& cage, const Vec3& x, double* row, RowScratch& 
     const double r0 = s.R[t[0]], r1 = s.R[t[1]], r2 = s.R[t[2]];
     const double det = a0.dot(a1.cross(a2));
     const double den = r0 * r1 * r2 + a0.dot(a1) * r2 + a1.dot(a2) * r0 + a2.dot(a0) * r1;
-    const double omega = twiceAtan2(det, den); // > 0 seen from behind the triangle
-    const double h = -cage.Normal[j].dot(a0);         // height of x over the plane
+    const double h = -cage.Normal[j].dot(a0); // height of x over the plane
     if (std::abs(h) <= cage.Tiny && den <= 0.0)
     {
       info.OnCage = true; // x on the triangle
       return info;
     }
+    s.Det[j] = det;
+    s.Den[j] = den;
+    s.In[j] = den != 0.0 ? det / den : 0.0;
+  }
+  vectorAtan(s.In.data(), s.Out.data(), static_cast<int>(nf));
+  double windingSum = 0.0;
+  double* phi = row;
+  double* psi = row + nv;
+  for (std::size_t j = 0; j < nf; ++j)
+  {
+    const Triangle& t = cage.Mesh.Triangles[j];
+    const Vec3& a0 = s.A[t[0]];
+    const double det = s.Det[j], den = s.Den[j];
+    // > 0 seen from behind the triangle; in (-2 pi, 2 pi]
+    const double omega = den > 0.0 ? 2.0 * s.Out[j]
+      : den < 0.0                  ? 2.0 * s.Out[j] + (det >= 0.0 ? 2.0 * Pi : -2.0 * Pi)
+                                   : (det > 0.0 ? Pi : (det < 0.0 ? -Pi : 0.0));
+    const double h = -cage.Normal[j].dot(a0);
     windingSum += omega;
     Vec3 m = Vec3::Zero();
     double dSum = 0.0;
@@ -794,7 +813,7 @@ CageBindingResult CageDeformer::bind(const TriangleMesh& restCage, const std::ve
         return;
       }
       RowScratch scratch;
-      scratch.resize(nv, d.Cage.Edges.size());
+      scratch.resize(nv, d.Cage.Edges.size(), nf);
       for (std::size_t p = range.begin(); p != range.end(); ++p)
       {
         double* row = d.Weights.row(static_cast<Eigen::Index>(p)).data();
