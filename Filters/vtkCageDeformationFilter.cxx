@@ -95,6 +95,7 @@ struct vtkCageDeformationFilter::vtkInternals
   vtkDataObject* Rest = nullptr;
   vtkMTimeType RestTime = 0;
   int Coordinates = -1;
+  bool Single = false;
   sdfcage::CageBindingResult Binding;
 };
 
@@ -207,7 +208,8 @@ int vtkCageDeformationFilter::RequestData(
     // the weights: computed again only when the points, the rest cage or the coordinates changed
     vtkInternals& in = *this->Internals;
     const bool current = in.Deformer.bound() && in.Input == input && in.InputTime == input->GetMTime() &&
-      in.Rest == rest && in.RestTime == rest->GetMTime() && in.Coordinates == this->Coordinates;
+      in.Rest == rest && in.RestTime == rest->GetMTime() && in.Coordinates == this->Coordinates &&
+      in.Single == (this->SinglePrecisionWeights != 0);
     if (!current)
     {
       in.Deformer.clear();
@@ -227,6 +229,7 @@ int vtkCageDeformationFilter::RequestData(
       sdfcage::CageCoordinateOptions options;
       options.Kind = this->Coordinates == GREEN ? sdfcage::CageCoordinateKind::Green : sdfcage::CageCoordinateKind::MeanValue;
       options.NumberOfThreads = this->NumberOfThreads;
+      options.SinglePrecision = this->SinglePrecisionWeights != 0;
       FilterProgress progress(this);
       this->UpdateProgress(0.0);
       in.Binding = in.Deformer.bind(in.RestCage, points, options, &progress);
@@ -252,6 +255,7 @@ int vtkCageDeformationFilter::RequestData(
       in.Rest = rest;
       in.RestTime = rest->GetMTime();
       in.Coordinates = this->Coordinates;
+      in.Single = options.SinglePrecision;
       this->WeightsRecomputed = true;
       this->PointsOutside = static_cast<vtkIdType>(in.Binding.PointsOutside);
       this->PointsOnCage = static_cast<vtkIdType>(in.Binding.PointsOnCage);
@@ -355,6 +359,7 @@ void vtkCageDeformationFilter::PrintSelf(ostream& os, vtkIndent indent)
   this->Superclass::PrintSelf(os, indent);
   os << indent << "Coordinates: " << (this->Coordinates == GREEN ? "Green" : "MeanValue") << "\n";
   os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";
+  os << indent << "SinglePrecisionWeights: " << (this->SinglePrecisionWeights ? "On" : "Off") << "\n";
   os << indent << "PointsOutside: " << this->PointsOutside << "\n";
   os << indent << "PointsOnCage: " << this->PointsOnCage << "\n";
   os << indent << "WeightTime: " << this->WeightTime << "\n";

@@ -29,6 +29,7 @@ constexpr double Pi = 3.14159265358979323846;
 constexpr double InvFourPi = 1.0 / (4.0 * Pi);
 
 using WeightMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+using FloatWeightMatrix = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 /// The rest cage with everything a weight row needs that depends on the cage only.
 struct CageFrame
@@ -201,8 +202,10 @@ struct RowScratch
   std::vector<double> F;    // per edge line integral of 1/R (Green)
   std::vector<double> In, Out; // arguments and values of the vector log / atan
   std::vector<double> Det, Den; // per triangle (Green): the solid angle's half-angle tangent
+  std::vector<double> Row;      // one weight row in double precision (single-precision storage)
   void resize(std::size_t nv, std::size_t ne, std::size_t nf)
   {
+    this->Row.resize(nv + nf);
     this->In.resize(std::max(ne, nf));
     this->Out.resize(std::max(ne, nf));
     this->Det.resize(nf);
@@ -703,7 +706,10 @@ struct CageDeformer::Data
 {
   CageCoordinateKind Kind = CageCoordinateKind::MeanValue;
   CageFrame Cage;
-  WeightMatrix Weights;
+  WeightMatrix Weights;         // double precision (the default)
+  FloatWeightMatrix WeightsF;   // or single precision
+  bool Single = false;
+  std::vector<Vec3> Residual;   // single precision: x - W_float B_rest per point
   std::vector<char> Green;
   std::vector<CageDeformer::Location> Where;
   bool Bound = false;
@@ -733,7 +739,8 @@ CageCoordinateKind CageDeformer::kind() const
 
 std::size_t CageDeformer::numberOfPoints() const
 {
-  return static_cast<std::size_t>(this->D->Weights.rows());
+  return this->D->Single ? static_cast<std::size_t>(this->D->WeightsF.rows())
+                         : static_cast<std::size_t>(this->D->Weights.rows());
 }
 
 std::size_t CageDeformer::numberOfCageVertices() const
@@ -783,10 +790,18 @@ CageBindingResult CageDeformer::bind(const TriangleMesh& restCage, const std::ve
   const std::size_t n = points.size();
   const std::size_t nv = cage.Points.size(), nf = cage.Triangles.size();
   const std::size_t columns = options.Kind == CageCoordinateKind::Green ? nv + nf : nv;
-  result.WeightBytes = 8.0 * static_cast<double>(n) * static_cast<double>(columns);
+  d.Single = options.SinglePrecision;
+  result.WeightBytes = (d.Single ? 4.0 : 8.0) * static_cast<double>(n) * static_cast<double>(columns);
   try
   {
-    d.Weights.resize(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(columns));
+    if (d.Single)
+    {
+      d.WeightsF.resize(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(columns));
+    }
+    else
+    {
+      d.Weights.resize(static_cast<Eigen::Index>(n), static_cast<Eigen::Index>(columns));
+    }
     d.Green.assign(n, 0);
     d.Where.assign(n, Location::Inside);
   }
@@ -816,7 +831,7 @@ CageBindingResult CageDeformer::bind(const TriangleMesh& restCage, const std::ve
       scratch.resize(nv, d.Cage.Edges.size(), nf);
       for (std::size_t p = range.begin(); p != range.end(); ++p)
       {
-        double* row = d.Weights.row(static_cast<Eigen::Index>(p)).data();
+        double* row = d.Single ? scratch.Row.data() : d.Weights.row(static_cast<Eigen::Index>(p)).data();
         RowInfo info;
         bool useGreen = false;
         if (options.Kind == CageCoordinateKind::Green)
@@ -838,6 +853,14 @@ CageBindingResult CageDeformer::bind(const TriangleMesh& restCage, const std::ve
           const bool greenOnCage = info.OnCage;
           info = meanValueRow(d.Cage, points[p], row, scratch);
           info.OnCage = info.OnCage || greenOnCage;
+        }
+        if (d.Single)
+        {
+          float* stored = d.WeightsF.row(static_cast<Eigen::Index>(p)).data();
+          for (std::size_t c = 0; c < columns; ++c)
+          {
+            stored[c] = static_cast<float>(row[c]);
+          }
         }
         d.Green[p] = useGreen ? 1 : 0;
         if (info.OnCage)
@@ -867,9 +890,18 @@ CageBindingResult CageDeformer::bind(const TriangleMesh& restCage, const std::ve
   result.MeanValueFallbacks = fallbacks.load();
   d.Bound = true;
 
-  // identity reproduction: the weights applied to the rest cage give the points back
+  // identity reproduction: the weights applied to the rest cage give the points back (single
+  // precision: before the per-point correction, which then makes it exact)
   std::vector<Vec3> again;
   this->apply(cage.Points, again, options.NumberOfThreads);
+  if (d.Single)
+  {
+    d.Residual.resize(n);
+    for (std::size_t p = 0; p < n; ++p)
+    {
+      d.Residual[p] = points[p] - again[p];
+    }
+  }
   double worst = 0.0;
   for (std::size_t p = 0; p < n; ++p)
   {
@@ -890,8 +922,9 @@ bool CageDeformer::apply(const std::vector<Vec3>& deformedCagePoints, std::vecto
     return false;
   }
   const WeightMatrix b = rightHandSide(d.Cage, d.Kind, deformedCagePoints);
-  const Eigen::Index n = d.Weights.rows();
+  const Eigen::Index n = static_cast<Eigen::Index>(this->numberOfPoints());
   out.resize(static_cast<std::size_t>(n));
+  const bool corrected = d.Single && d.Residual.size() == static_cast<std::size_t>(n);
   ThreadLimit limit(numberOfThreads);
   // One pass over the weights, row by row: three dot products per row (the row stays in the
   // first-level cache for the second and third), the columns of b contiguous. Memory bound: the
@@ -900,9 +933,21 @@ bool CageDeformer::apply(const std::vector<Vec3>& deformedCagePoints, std::vecto
   tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, n, 512), [&](const tbb::blocked_range<Eigen::Index>& r) {
     for (Eigen::Index i = r.begin(); i != r.end(); ++i)
     {
-      const auto row = d.Weights.row(i);
-      out[static_cast<std::size_t>(i)] =
-        Vec3(row.dot(columns.col(0).transpose()), row.dot(columns.col(1).transpose()), row.dot(columns.col(2).transpose()));
+      Vec3& y = out[static_cast<std::size_t>(i)];
+      if (d.Single)
+      {
+        const auto row = d.WeightsF.row(i).cast<double>();
+        y = Vec3(row.dot(columns.col(0).transpose()), row.dot(columns.col(1).transpose()), row.dot(columns.col(2).transpose()));
+        if (corrected)
+        {
+          y += d.Residual[static_cast<std::size_t>(i)];
+        }
+      }
+      else
+      {
+        const auto row = d.Weights.row(i);
+        y = Vec3(row.dot(columns.col(0).transpose()), row.dot(columns.col(1).transpose()), row.dot(columns.col(2).transpose()));
+      }
     }
   });
   return true;
@@ -910,6 +955,11 @@ bool CageDeformer::apply(const std::vector<Vec3>& deformedCagePoints, std::vecto
 
 std::vector<double> CageDeformer::weights(std::size_t p) const
 {
+  if (this->D->Single)
+  {
+    const auto row = this->D->WeightsF.row(static_cast<Eigen::Index>(p));
+    return std::vector<double>(row.data(), row.data() + row.size());
+  }
   const auto row = this->D->Weights.row(static_cast<Eigen::Index>(p));
   return std::vector<double>(row.data(), row.data() + row.size());
 }

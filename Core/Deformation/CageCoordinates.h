@@ -62,6 +62,11 @@ struct CageCoordinateOptions
   CageCoordinateKind Kind = CageCoordinateKind::MeanValue;
   /// Worker threads (0 = all cores); the weights do not depend on it.
   int NumberOfThreads = 0;
+  /// Store the weights in single precision: half the memory and about half the apply time. The
+  /// rest cage still gives the points back exactly (a per-point correction, x - W B_rest, is kept
+  /// in double precision), but a deformed cage is followed only to about 1e-7 of its
+  /// displacement (affine maps, similarities) instead of 1e-9 of the size.
+  bool SinglePrecision = false;
 };
 
 /// What binding points to a cage did.
@@ -78,10 +83,11 @@ struct CageBindingResult
   /// The cage's triangles were inward (negative volume) and were used reversed.
   bool CageWasFlipped = false;
   /// max_x |x - (weights applied to the rest cage)| / cage diagonal, over the points (identity
-  /// reproduction; ~1e-14 for points inside).
+  /// reproduction; ~1e-11 or better for points inside; with SinglePrecision: of the rounded weights
+  /// before the correction, ~1e-7).
   double ReproductionError = 0.0;
   double WeightTime = 0.0;
-  /// Bytes held by the weight matrix.
+  /// Bytes held by the weight matrix (8 or, with SinglePrecision, 4 per entry).
   double WeightBytes = 0.0;
 };
 

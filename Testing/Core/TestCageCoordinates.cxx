@@ -480,3 +480,32 @@ TEST(CageCoordinates, InsideTestsAgree)
   }
   EXPECT_EQ(r.PointsOutside, expectedOutside);
 }
+
+TEST(CageCoordinates, SinglePrecisionWeights)
+{
+  const TorusCase c;
+  const double diag = diagonal(c.Cage);
+  const Eigen::Matrix3d similarity = 1.3 * Eigen::AngleAxisd(0.5, Vec3(0, 1, 1).normalized()).toRotationMatrix();
+  const Vec3 t(0.2, 0.4, -1.0);
+  for (CageCoordinateKind kind : Kinds)
+  {
+    CageDeformer single, full;
+    CageCoordinateOptions o;
+    o.Kind = kind;
+    ASSERT_EQ(full.bind(c.Cage, c.Points, o).State, Status::Ok);
+    o.SinglePrecision = true;
+    const CageBindingResult r = single.bind(c.Cage, c.Points, o);
+    ASSERT_EQ(r.State, Status::Ok);
+    EXPECT_GT(r.ReproductionError, 0.0); // the rounded weights alone miss the points ...
+    EXPECT_LT(r.ReproductionError, 1e-5);
+    std::vector<Vec3> out, ref;
+    ASSERT_TRUE(single.apply(c.Cage.Points, out));
+    EXPECT_LT(maxError(out, c.Points), 1e-12 * diag); // ... the correction makes the identity exact
+    ASSERT_TRUE(single.apply(mapped(c.Cage.Points, similarity, t), out));
+    ASSERT_TRUE(full.apply(mapped(c.Cage.Points, similarity, t), ref));
+    const double e = maxError(out, ref);
+    EXPECT_LT(e, 1e-5 * diag) << cageCoordinateKindName(kind);
+    EXPECT_GT(e, 0.0) << cageCoordinateKindName(kind);
+    EXPECT_EQ(single.weights(3).size(), full.weights(3).size());
+  }
+}

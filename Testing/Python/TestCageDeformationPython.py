@@ -116,6 +116,35 @@ def test_reproduction_and_maps():
         mesh.Update()
 
 
+def test_single_precision():
+    cage = sphere(1.0, 12)
+    mesh = sphere(0.6, 24)
+    x = points(mesh.GetOutput())
+    c, s = math.cos(0.6), math.sin(0.6)
+    a = [[1.5 * c, -1.5 * s, 0.0], [1.5 * s, 1.5 * c, 0.0], [0.0, 0.0, 1.5]]
+    moved, _ = transform(cage, a, [0.5, -1.0, 2.0])
+    expected = x @ np.array(a).T + np.array([0.5, -1.0, 2.0])
+    for kind in ("MeanValue", "Green"):
+        f = sdfcage.vtkCageDeformationFilter()
+        getattr(f, "SetCoordinatesTo" + kind)()
+        check(not f.GetSinglePrecisionWeights(), "%s: SinglePrecisionWeights off by default" % kind)
+        f.SinglePrecisionWeightsOn()
+        f.SetInputConnection(mesh.GetOutputPort())
+        f.SetRestCageConnection(cage.GetOutputPort())
+        f.SetDeformedCageConnection(cage.GetOutputPort())
+        f.Update()
+        err = np.abs(points(f.GetOutput()) - x).max()
+        check(err < 1e-12, "%s single: rest = deformed still reproduces the input (%.2g)" % (kind, err))
+        f.SetDeformedCageConnection(moved.GetOutputPort())
+        f.Update()
+        check(not f.GetWeightsRecomputed(), "%s single: moving the cage keeps the weights" % kind)
+        err = np.abs(points(f.GetOutput()) - expected).max()
+        check(err < 1e-5, "%s single: a similarity to %.2g" % (kind, err))
+        f.SinglePrecisionWeightsOff()
+        f.Update()
+        check(f.GetWeightsRecomputed(), "%s: switching the precision recomputes the weights" % kind)
+
+
 def test_green_is_not_mvc_and_finite():
     cage = sphere(1.0, 12)
     mesh = sphere(0.8, 24)
@@ -221,6 +250,7 @@ def test_errors():
 
 if __name__ == "__main__":
     test_reproduction_and_maps()
+    test_single_precision()
     test_green_is_not_mvc_and_finite()
     test_unstructured_grid_and_outside_points()
     test_errors()
