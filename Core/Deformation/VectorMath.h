@@ -10,4 +10,9 @@ namespace sdfcage
 void vectorLog(const double* in, double* out, int n);
 /// out[i] = atan(in[i]) for finite in[i].
 void vectorAtan(const double* in, double* out, int n);
+/// out = (w . bx, w . by, w . bz) for single-precision w, accumulated in double precision (in an
+/// order the compiler chooses: vectorized).
+void floatRowTimes3(const float* w, const double* bx, const double* by, const double* bz, int n, double out[3]);
+/// The same for a double-precision w.
+void rowTimes3(const double* w, const double* bx, const double* by, const double* bz, int n, double out[3]);
 } // namespace sdfcage
