@@ -95,7 +95,7 @@ class Ranks:
 
 
 # --- the meshes --------------------------------------------------------------------------------------
-def list_meshes(inputs, recursive):
+def list_meshes(inputs, recursive, order="size"):
     paths = []
     for item in inputs:
         if os.path.isdir(item):
@@ -126,6 +126,8 @@ def list_meshes(inputs, recursive):
                 name = "%s_%d" % (name, i)
             names[p] = name
     size = lambda p: os.path.getsize(p) if os.path.exists(p) else 0  # noqa: E731
+    if order == "list":  # as given (e.g. the slowest of an earlier run first)
+        return [(names[p], p) for p in meshes]
     # largest first (the file size stands for the work: reading it costs nothing)
     return [(names[p], p) for p in sorted(meshes, key=lambda p: (-size(p), p))]
 
@@ -277,9 +279,11 @@ def write_summary(meshes, args, wall, ranks_used):
     busy = sum(float(r.get("time_s") or 0) for r in rows)
     with open(os.path.join(out, "summary.md"), "w") as f:
         f.write("# SDFCage batch\n\n")
-        f.write("%d meshes, %d caged and verified, %d not; target %d vertices; this run: %d rank(s), wall %.1f s; "
+        run = ("rebuilt from the records" if args.summary_only
+               else "this run: %d rank(s), wall %.1f s" % (ranks_used, wall))
+        f.write("%d meshes, %d caged and verified, %d not; target %d vertices; %s; "
                 "sum of the per-mesh times (this and earlier runs) %.1f s.\n\n"
-                % (len(rows), verified, len(rows) - verified, args.vertices, ranks_used, wall, busy))
+                % (len(rows), verified, len(rows) - verified, args.vertices, run, busy))
         f.write("| mesh | faces | target | vertices | time s | verdict | error | rank |\n")
         f.write("|---|---|---|---|---|---|---|---|\n")
         for r in rows:
@@ -358,6 +362,8 @@ def parse(argv):
                     help="threads per mesh (default: the cores of the node divided by its ranks)")
     ap.add_argument("--timeout", type=float, default=0, help="seconds per mesh before it is given up (0: none)")
     ap.add_argument("--recursive", action="store_true", help="also the meshes in sub-folders")
+    ap.add_argument("--order", choices=("size", "list"), default="size",
+                    help="hand-out order: largest file first (default) or as listed")
     ap.add_argument("--retry-failed", action="store_true", help="redo the meshes whose verdict was not verified")
     ap.add_argument("--summary-only", action="store_true", help="only rebuild the summary and cages.vtpc")
     ap.add_argument("--sdfcage", default="", help="the sdfcage program (default: found beside the plugin or on PATH)")
@@ -384,7 +390,7 @@ def main(argv):
             ok = 0
     if not ranks.broadcast_int(ok):
         return 2
-    meshes = list_meshes(args.inputs, args.recursive)  # every rank lists the same, in the same order
+    meshes = list_meshes(args.inputs, args.recursive, args.order)  # every rank lists the same, in the same order
     todo = [] if args.summary_only else [m for m in meshes if not finished(args.output, m[0], args.retry_failed)]
     if ranks.rank == 0:
         print("sdfcage_batch: %d meshes, %d to do (%d already done), %d rank(s), %d thread(s) per mesh, program %s"

@@ -188,4 +188,31 @@ for name, mesh in meshes:
     Delete(c)
     Delete(reader)
 
+# --- 5. pieces with a layer of ghost cells (a programmable source on every rank) ---------------------
+here = os.path.dirname(os.path.abspath(__file__))
+ghosted = ProgrammableSource(OutputDataSetType="vtkPolyData")
+ghosted.ScriptRequestInformation = (
+    "from vtkmodules.vtkCommonExecutionModel import vtkAlgorithm\n"
+    "self.GetExecutive().GetOutputInformation(0).Set(vtkAlgorithm.CAN_HANDLE_PIECE_REQUEST(), 1)\n")
+ghosted.Script = (
+    "import sys\n"
+    "sys.path.insert(0, %r)\n"
+    "from mpi_pieces import piece_with_ghosts, torus_mesh\n"
+    "from vtkmodules.vtkCommonExecutionModel import vtkStreamingDemandDrivenPipeline as SDDP\n"
+    "info = self.GetOutputInformation(0)\n"
+    "k, n = info.Get(SDDP.UPDATE_PIECE_NUMBER()), info.Get(SDDP.UPDATE_NUMBER_OF_PIECES())\n"
+    "self.GetOutput().ShallowCopy(piece_with_ghosts(torus_mesh(), k, n))\n" % here)
+ghosted.UpdatePipeline()
+torus = torus_mesh()
+chk.check(ghosted.GetDataInformation().GetNumberOfCells() > torus.GetNumberOfPolys(),
+          "ghost pieces: %d cells over the ranks (ghost layers included), %d in the torus"
+          % (ghosted.GetDataInformation().GetNumberOfCells(), torus.GetNumberOfPolys()))
+gc = SDFCage(Input=ghosted, IsoValue=0.02, TargetNumberOfVertices=150)
+gc.UpdatePipeline()
+go = servermanager.Fetch(gc)
+gref = serial_cage(torus, IsoValue=0.02, TargetNumberOfVertices=150)
+same_surface(chk, "torus cage from ghosted pieces", go, gref.GetOutput(0))
+# kept ghost cells would arrive as duplicated triangles (counted as dropped duplicates)
+same_results(chk, "torus cage from ghosted pieces", go, gref.GetOutput(0), RESULTS + ["DroppedDuplicateTriangles"])
+
 chk.finish()

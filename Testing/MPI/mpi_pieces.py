@@ -7,7 +7,7 @@ which vtkXMLPolyDataReader / ParaView's XML PolyData reader hand out to the rank
 import math
 
 from vtkmodules.util.vtkAlgorithm import VTKPythonAlgorithmBase
-from vtkmodules.vtkCommonCore import vtkIdList, vtkPoints
+from vtkmodules.vtkCommonCore import vtkIdList, vtkPoints, vtkUnsignedCharArray
 from vtkmodules.vtkCommonDataModel import vtkCellArray, vtkPolyData
 from vtkmodules.vtkCommonExecutionModel import vtkAlgorithm, vtkStreamingDemandDrivenPipeline as SDDP
 from vtkmodules.vtkIOXML import vtkXMLPolyDataWriter
@@ -35,6 +35,44 @@ def piece_of(mesh, k, n):
         cells.InsertNextCell(new)
     out.SetPoints(points)
     out.SetPolys(cells)
+    return out
+
+
+def piece_with_ghosts(mesh, k, n):
+    """Piece k of n as piece_of, plus one layer of ghost cells (the other pieces' cells that share
+    a point with it), flagged as duplicated in the cell array vtkGhostType, as ghost-cell
+    generators make them."""
+    polys = mesh.GetPolys()
+    count = polys.GetNumberOfCells()
+    first, last = k * count // n, (k + 1) * count // n
+    ids = vtkIdList()
+    own_points = set()
+    cells = []
+    for c in range(count):
+        polys.GetCellAtId(c, ids)
+        cells.append([ids.GetId(j) for j in range(ids.GetNumberOfIds())])
+    for c in range(first, last):
+        own_points.update(cells[c])
+    chosen = list(range(first, last)) + [c for c in range(count)
+                                         if not first <= c < last and any(p in own_points for p in cells[c])]
+    out = vtkPolyData()
+    points = vtkPoints()
+    points.SetDataTypeToDouble()
+    polys_out = vtkCellArray()
+    ghosts = vtkUnsignedCharArray()
+    ghosts.SetName("vtkGhostType")
+    index = {}
+    for c in chosen:
+        new = []
+        for p in cells[c]:
+            if p not in index:
+                index[p] = points.InsertNextPoint(mesh.GetPoint(p))
+            new.append(index[p])
+        polys_out.InsertNextCell(len(new), new)
+        ghosts.InsertNextValue(0 if first <= c < last else 1)  # 1: vtkDataSetAttributes::DUPLICATECELL
+    out.SetPoints(points)
+    out.SetPolys(polys_out)
+    out.GetCellData().AddArray(ghosts)
     return out
 
 
