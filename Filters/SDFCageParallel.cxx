@@ -88,7 +88,10 @@ public:
     return -1;
   }
 
-  void add(const double x[3], vtkIdType id, std::size_t piece) { this->Bins.emplace(this->binOf(x), std::make_pair(id, piece)); }
+  void add(const double x[3], vtkIdType id, std::size_t piece)
+  {
+    this->Bins.emplace(this->binOf(x), std::make_pair(id, piece));
+  }
 
 private:
   using Bin = std::array<long long, 3>;
@@ -110,8 +113,9 @@ private:
     Bin b;
     for (int k = 0; k < 3; ++k)
     {
-      b[static_cast<std::size_t>(k)] =
-        this->Tolerance > 0 ? static_cast<long long>(std::max(-4e18, std::min(4e18, std::floor(x[k] / this->Tolerance)))) : 0;
+      b[static_cast<std::size_t>(k)] = this->Tolerance > 0
+        ? static_cast<long long>(std::max(-4e18, std::min(4e18, std::floor(x[k] / this->Tolerance))))
+        : 0;
     }
     return b;
   }
@@ -262,18 +266,19 @@ bool IsDuplicateGhost(vtkUnsignedCharArray* ghosts, vtkIdType cellId)
 } // namespace
 
 //------------------------------------------------------------------------------
-void RequestSamePieceWithoutGhosts(
-  vtkInformationVector** inputVector, int numberOfInputPorts, vtkInformationVector* outputVector, vtkInformation* request)
+void RequestSamePieceWithoutGhosts(vtkInformationVector** inputVector, int numberOfInputPorts,
+  vtkInformationVector* outputVector, vtkInformation* request)
 {
-  int port = request && request->Has(vtkExecutive::FROM_OUTPUT_PORT()) ? request->Get(vtkExecutive::FROM_OUTPUT_PORT())
-                                                                          : 0;
+  int port =
+    request && request->Has(vtkExecutive::FROM_OUTPUT_PORT()) ? request->Get(vtkExecutive::FROM_OUTPUT_PORT()) : 0;
   if (port < 0 || port >= outputVector->GetNumberOfInformationObjects())
   {
     port = 0;
   }
   vtkInformation* outInfo = outputVector->GetInformationObject(port);
   using SDDP = vtkStreamingDemandDrivenPipeline;
-  const int piece = outInfo && outInfo->Has(SDDP::UPDATE_PIECE_NUMBER()) ? outInfo->Get(SDDP::UPDATE_PIECE_NUMBER()) : 0;
+  const int piece =
+    outInfo && outInfo->Has(SDDP::UPDATE_PIECE_NUMBER()) ? outInfo->Get(SDDP::UPDATE_PIECE_NUMBER()) : 0;
   const int pieces =
     outInfo && outInfo->Has(SDDP::UPDATE_NUMBER_OF_PIECES()) ? outInfo->Get(SDDP::UPDATE_NUMBER_OF_PIECES()) : 1;
   for (int p = 0; p < numberOfInputPorts; ++p)
@@ -450,8 +455,8 @@ vtkSmartPointer<vtkPolyData> JoinPieces(const std::vector<vtkPolyData*>& pieces,
   // the cell ids of a vtkPolyData: verts first, then lines, polys, strips
   auto verts = join(&vtkPolyData::GetVerts, [](vtkPolyData*) -> vtkIdType { return 0; });
   auto lines = join(&vtkPolyData::GetLines, [](vtkPolyData* p) -> vtkIdType { return p->GetNumberOfVerts(); });
-  auto polys = join(&vtkPolyData::GetPolys,
-    [](vtkPolyData* p) -> vtkIdType { return p->GetNumberOfVerts() + p->GetNumberOfLines(); });
+  auto polys = join(
+    &vtkPolyData::GetPolys, [](vtkPolyData* p) -> vtkIdType { return p->GetNumberOfVerts() + p->GetNumberOfLines(); });
   auto strips = join(&vtkPolyData::GetStrips,
     [](vtkPolyData* p) -> vtkIdType { return p->GetNumberOfVerts() + p->GetNumberOfLines() + p->GetNumberOfPolys(); });
   output->SetVerts(verts);

@@ -74,6 +74,36 @@ chk.check(cage.GetDataInformation().GetNumberOfPoints() == ref_out.GetNumberOfPo
 cage.UpdatePropertyInformation()
 chk.check(cage.GetProperty("StatusInfo").GetElement(0) == "Ok", "information property StatusInfo Ok")
 chk.check(cage.GetProperty("VerticesReachedInfo").GetElement(0) == 100, "information property VerticesReachedInfo 100")
+# every rank reports process 0's results: a programmable filter on each rank turns the field data
+# its (possibly empty) piece of the cage carries into one point per rank
+probe = ProgrammableFilter(Input=cage, OutputDataSetType="vtkPolyData")
+probe.Script = (
+    "from vtkmodules.vtkCommonCore import vtkPoints, vtkIntArray\n"
+    "from vtkmodules.vtkParallelCore import vtkMultiProcessController\n"
+    "rank = vtkMultiProcessController.GetGlobalController().GetLocalProcessId()\n"
+    "fd = self.GetInput().GetFieldData()\n"
+    "out = self.GetOutput()\n"
+    "pts = vtkPoints()\n"
+    "pts.InsertNextPoint(rank, 0, 0)\n"
+    "out.SetPoints(pts)\n"
+    "for name in ('EnclosureVerified', 'VerticesReached'):\n"
+    "    a = vtkIntArray()\n"
+    "    a.SetName(name)\n"
+    "    v = fd.GetArray(name)\n"
+    "    a.InsertNextValue(int(v.GetValue(0)) if v is not None else -1)\n"
+    "    out.GetPointData().AddArray(a)\n"
+    "r = vtkIntArray()\n"
+    "r.SetName('Rank')\n"
+    "r.InsertNextValue(rank)\n"
+    "out.GetPointData().AddArray(r)\n")
+probe.UpdatePipeline()
+po = servermanager.Fetch(probe)
+per_rank = {int(po.GetPointData().GetArray("Rank").GetValue(i)): (int(po.GetPointData().GetArray("EnclosureVerified").GetValue(i)),
+                                                                   int(po.GetPointData().GetArray("VerticesReached").GetValue(i)))
+            for i in range(po.GetNumberOfPoints())}
+chk.check(sorted(per_rank) == list(range(ranks)) and all(v == (1, 100) for v in per_rank.values()),
+          "every rank's piece carries the results (EnclosureVerified, VerticesReached by rank: %s)" % per_rank)
+Delete(probe)
 env_info = cage.GetDataInformation(1)
 chk.check(env_info.GetNumberOfPoints() == ref.GetOutput(1).GetNumberOfPoints(),
           "envelope: %d points over all ranks, %d serial" % (env_info.GetNumberOfPoints(), ref.GetOutput(1).GetNumberOfPoints()))
