@@ -101,7 +101,8 @@ po = servermanager.Fetch(probe)
 per_rank = {int(po.GetPointData().GetArray("Rank").GetValue(i)): (int(po.GetPointData().GetArray("EnclosureVerified").GetValue(i)),
                                                                    int(po.GetPointData().GetArray("VerticesReached").GetValue(i)))
             for i in range(po.GetNumberOfPoints())}
-chk.check(sorted(per_rank) == list(range(ranks)) and all(v == (1, 100) for v in per_rank.values()),
+# (paraview.simple's * import shadows all(): compare lists)
+chk.check(sorted(per_rank) == list(range(ranks)) and [v for v in per_rank.values() if v != (1, 100)] == [],
           "every rank's piece carries the results (EnclosureVerified, VerticesReached by rank: %s)" % per_rank)
 Delete(probe)
 env_info = cage.GetDataInformation(1)
