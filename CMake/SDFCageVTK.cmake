@@ -55,7 +55,7 @@ mark_as_advanced(SDFCAGE_PYTHON_DESTINATION)
 
 # What the module itself needs, what the tests need, what the CLI may use.
 set(_sdfcage_vtk_module_components
-  CommonCore CommonDataModel CommonExecutionModel CommonMisc IOCore)
+  CommonCore CommonDataModel CommonExecutionModel CommonMisc IOCore ParallelCore)
 set(_sdfcage_vtk_test_components
   FiltersCore FiltersSources FiltersGeneral)
 set(_sdfcage_vtk_io_components

@@ -20,6 +20,7 @@
 #include "vtkUnsignedCharArray.h"
 
 #include "Envelope/ActivePointAnalysis.h"
+#include "SDFCageParallel.h"
 #include "SDFCageVTKConversion.h"
 
 #include <exception>
@@ -62,10 +63,36 @@ int vtkActivePointFilter::FillOutputPortInformation(int port, vtkInformation* in
 }
 
 //------------------------------------------------------------------------------
+int vtkActivePointFilter::RequestUpdateExtent(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  RequestSamePieceWithoutGhosts(inputVector, this->GetNumberOfInputPorts(), outputVector, request);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+// On the whole input: directly in a serial run, on process 0 with the gathered pieces under MPI
+// (the other processes adopt process 0's results).
 int vtkActivePointFilter::RequestData(
   vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
-  vtkPolyData* input = vtkPolyData::GetData(inputVector[0], 0);
+  WholeSurfaceRun run;
+  run.ResultsPort = 0;
+  run.ImagePorts = { 1 };
+  return RunOnWholeSurface(
+    this, inputVector, outputVector, run,
+    [this, outputVector](const std::vector<vtkPolyData*>& inputs) { return this->Execute(inputs[0], outputVector); },
+    [this](vtkFieldData* fd) {
+      this->Internals->Results = sdfcage::activePointResults(sdfcage::ActivePointAnalysis());
+      ReadResultArrays(fd, this->Internals->Results);
+      this->StatusString = FieldText(fd, "Status");
+      this->LastErrorMessage = FieldText(fd, "LastErrorMessage");
+    });
+}
+
+//------------------------------------------------------------------------------
+int vtkActivePointFilter::Execute(vtkPolyData* input, vtkInformationVector* outputVector)
+{
   vtkPolyData* output = vtkPolyData::GetData(outputVector, 0);
   vtkImageData* fields = vtkImageData::GetData(outputVector, 1);
   this->Internals->Results = sdfcage::activePointResults(sdfcage::ActivePointAnalysis());

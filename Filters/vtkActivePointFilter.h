@@ -32,6 +32,10 @@
  * empty outputs without an error. Abort (SetAbortExecute) stops the search promptly with empty
  * outputs.
  *
+ * Under MPI, when each process is given its piece of the input, the pieces are gathered on
+ * process 0 and analysed there (see vtkSDFCageFilter): process 0 outputs the serial result, the
+ * others empty outputs with the same results field data.
+ *
  * @sa vtkSDFCageFilter
  */
 
@@ -128,6 +132,7 @@ protected:
   ~vtkActivePointFilter() override;
 
   int FillOutputPortInformation(int port, vtkInformation* info) override;
+  int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
   double ActiveRadius;
@@ -144,6 +149,8 @@ protected:
 private:
   vtkActivePointFilter(const vtkActivePointFilter&) = delete;
   void operator=(const vtkActivePointFilter&) = delete;
+
+  int Execute(vtkPolyData* input, vtkInformationVector* outputVector); // on the whole input
 
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;

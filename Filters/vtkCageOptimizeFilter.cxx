@@ -19,6 +19,7 @@
 #include "Mesh/Normalization.h"
 #include "Optimization/Optimization.h"
 #include "Mesh/Validation.h"
+#include "SDFCageParallel.h"
 #include "SDFCageVTKConversion.h"
 
 #include <exception>
@@ -119,12 +120,36 @@ int vtkCageOptimizeFilter::FillInputPortInformation(int port, vtkInformation* in
 }
 
 //------------------------------------------------------------------------------
+int vtkCageOptimizeFilter::RequestUpdateExtent(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  RequestSamePieceWithoutGhosts(inputVector, this->GetNumberOfInputPorts(), outputVector, request);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+// On the whole inputs: directly in a serial run, on process 0 with the gathered pieces under MPI
+// (the other processes adopt process 0's results).
 int vtkCageOptimizeFilter::RequestData(
   vtkInformation* vtkNotUsed(request), vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
+  WholeSurfaceRun run;
+  return RunOnWholeSurface(
+    this, inputVector, outputVector, run,
+    [this, outputVector](
+      const std::vector<vtkPolyData*>& inputs) { return this->Execute(inputs[0], inputs[1], outputVector); },
+    [this](vtkFieldData* fd) {
+      this->ResetResults();
+      ReadResultArrays(fd, this->Internals->Results);
+      this->StatusString = FieldText(fd, "Status");
+      this->LastErrorMessage = FieldText(fd, "LastErrorMessage");
+    });
+}
+
+//------------------------------------------------------------------------------
+int vtkCageOptimizeFilter::Execute(vtkPolyData* cage, vtkPolyData* source, vtkInformationVector* outputVector)
+{
   this->ResetResults();
-  vtkPolyData* cage = vtkPolyData::GetData(inputVector[0], 0);
-  vtkPolyData* source = vtkPolyData::GetData(inputVector[1], 0);
   vtkPolyData* output = vtkPolyData::GetData(outputVector, 0);
   if (!output)
   {

@@ -40,6 +40,10 @@
  * manifold surfaces. Vertices whose neighbourhood already violates a margin do not move. A missing
  * or empty input is not an error: the output is empty.
  *
+ * Under MPI, when each process is given its piece of the cage and of the source, both are
+ * gathered on process 0 and optimized there (see vtkSDFCageFilter): process 0 outputs the serial
+ * result, the others an empty cage with the same results field data.
+ *
  * @sa
  * vtkSDFCageFilter
  */
@@ -183,6 +187,7 @@ protected:
   ~vtkCageOptimizeFilter() override;
 
   int FillInputPortInformation(int port, vtkInformation* info) override;
+  int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
   int Energy;
@@ -201,6 +206,7 @@ private:
   vtkCageOptimizeFilter(const vtkCageOptimizeFilter&) = delete;
   void operator=(const vtkCageOptimizeFilter&) = delete;
 
+  int Execute(vtkPolyData* cage, vtkPolyData* source, vtkInformationVector* outputVector); // on the whole inputs
   void ResetResults();
   void PublishResults(vtkPolyData* output) const;
 

@@ -27,6 +27,7 @@
 
 #include "Quality/CageQuality.h"
 #include "Common/Progress.h"
+#include "SDFCageParallel.h"
 #include "SDFCageVTKConversion.h"
 
 #include <cmath>
@@ -195,12 +196,34 @@ void vtkCageQualityFilter::ResetResults()
 }
 
 //------------------------------------------------------------------------------
+int vtkCageQualityFilter::RequestUpdateExtent(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  sdfcage_vtk::RequestSamePieceWithoutGhosts(inputVector, this->GetNumberOfInputPorts(), outputVector, request);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+// On the whole inputs: directly in a serial run, on process 0 with the gathered pieces under MPI
+// (the other processes adopt process 0's results).
 int vtkCageQualityFilter::RequestData(
   vtkInformation* vtkNotUsed(request), vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
+  sdfcage_vtk::WholeSurfaceRun run;
+  return sdfcage_vtk::RunOnWholeSurface(
+    this, inputVector, outputVector, run,
+    [this, outputVector](
+      const std::vector<vtkPolyData*>& inputs) { return this->Execute(inputs[0], inputs[1], outputVector); },
+    [this](vtkFieldData* fd) {
+      this->ResetResults();
+      sdfcage_vtk::ReadResultArrays(fd, this->Internals->Results);
+    });
+}
+
+//------------------------------------------------------------------------------
+int vtkCageQualityFilter::Execute(vtkPolyData* cage, vtkPolyData* mesh, vtkInformationVector* outputVector)
+{
   this->ResetResults();
-  vtkPolyData* cage = vtkPolyData::GetData(inputVector[0], 0);
-  vtkPolyData* mesh = vtkPolyData::GetData(inputVector[1], 0);
   vtkPolyData* output = vtkPolyData::GetData(outputVector, 0);
   if (!output)
   {

@@ -48,6 +48,10 @@
  * QualityMessage says why. An empty cage gives an empty output; an empty input mesh gives the
  * cage with Encloses 0.
  *
+ * Under MPI, when each process is given its piece of the cage and of the mesh, both are gathered
+ * on process 0 and judged there (see vtkSDFCageFilter): process 0 outputs the serial result, the
+ * others an empty output with the same results field data.
+ *
  * @sa
  * vtkSDFCageFilter vtkDistancePolyDataFilter vtkMeshQuality
  */
@@ -133,11 +137,13 @@ protected:
   ~vtkCageQualityFilter() override;
 
   int FillInputPortInformation(int port, vtkInformation* info) override;
+  int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
   double HausdorffTolerance;
 
 private:
+  int Execute(vtkPolyData* cage, vtkPolyData* mesh, vtkInformationVector* outputVector); // on the whole inputs
   void ResetResults();
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;

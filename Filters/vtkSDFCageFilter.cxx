@@ -27,6 +27,7 @@
 
 #include "Pipeline/CageGenerator.h"
 #include "Pipeline/Results.h"
+#include "SDFCageParallel.h"
 #include "SDFCageVTKConversion.h"
 #include "Common/Progress.h"
 
@@ -147,12 +148,42 @@ std::string OrNoReason(const std::string& message)
 } // namespace
 
 //------------------------------------------------------------------------------
+int vtkSDFCageFilter::RequestUpdateExtent(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  RequestSamePieceWithoutGhosts(inputVector, this->GetNumberOfInputPorts(), outputVector, request);
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+// On the whole input: directly in a serial run, on process 0 with the gathered pieces under MPI.
 int vtkSDFCageFilter::RequestData(
   vtkInformation* vtkNotUsed(request), vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
+  WholeSurfaceRun run;
+  run.ResultsPort = 0;
+  run.ImagePorts = { 2 };
+  return RunOnWholeSurface(
+    this, inputVector, outputVector, run,
+    [this, outputVector](const std::vector<vtkPolyData*>& inputs) { return this->Execute(inputs[0], outputVector); },
+    [this](vtkFieldData* fd) { this->AdoptResults(fd); });
+}
+
+//------------------------------------------------------------------------------
+// Process 0's results on the other processes of an MPI run.
+void vtkSDFCageFilter::AdoptResults(vtkFieldData* fd)
+{
+  this->ResetResults();
+  ReadResultArrays(fd, this->Internals->Results);
+  this->StatusString = FieldText(fd, "Status");
+  this->LastErrorMessage = FieldText(fd, "LastErrorMessage");
+}
+
+//------------------------------------------------------------------------------
+int vtkSDFCageFilter::Execute(vtkPolyData* input, vtkInformationVector* outputVector)
+{
   this->ResetResults();
 
-  vtkPolyData* input = vtkPolyData::GetData(inputVector[0], 0);
   vtkPolyData* cageOutput = vtkPolyData::GetData(outputVector, 0);
   vtkPolyData* envelopeOutput = vtkPolyData::GetData(outputVector, 1);
   vtkImageData* fieldOutput = vtkImageData::GetData(outputVector, 2);

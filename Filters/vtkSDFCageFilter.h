@@ -64,6 +64,15 @@
  * are empty. The sampled grid's memory grows as 1/VoxelSize^2 (narrow band); GenerateDistanceField
  * stores a dense grid (1/VoxelSize^3 values).
  *
+ * Under MPI (pvbatch or pvserver under mpiexec, or any program whose global controller has
+ * several processes), when each process is given its piece of the input (as many pieces as
+ * processes), the pieces are gathered on process 0 (seam points shared by pieces merged, ghost
+ * cells dropped) and the cage is computed there: process 0 outputs what a serial run outputs, the
+ * other processes empty outputs (an empty image with the same origin, spacing and arrays) with
+ * the same results field data, and every process's getters report process 0's results. Every
+ * process must execute the filter then (ParaView's data servers all do). A request for the whole
+ * input (piece 0 of 1) runs on the calling process alone, without communication.
+ *
  * @sa
  * vtkFillHolesFilter vtkTriangleFilter vtkCleanPolyData vtkQuadricDecimation vtkOFFReader
  * vtkOFFWriter vtkCageOptimizeFilter
@@ -83,6 +92,7 @@ namespace sdfcage
 struct CageResult;
 }
 
+class vtkFieldData;
 class vtkImageData;
 
 class SDFCAGEFILTERS_EXPORT vtkSDFCageFilter : public vtkPolyDataAlgorithm
@@ -380,6 +390,7 @@ protected:
   ~vtkSDFCageFilter() override;
 
   int FillOutputPortInformation(int port, vtkInformation* info) override;
+  int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
   // parameters
@@ -416,7 +427,9 @@ private:
   vtkSDFCageFilter(const vtkSDFCageFilter&) = delete;
   void operator=(const vtkSDFCageFilter&) = delete;
 
-  // the phases of RequestData
+  // the phases of RequestData (Execute: on the whole input, see SDFCageParallel.h)
+  int Execute(vtkPolyData* input, vtkInformationVector* outputVector);
+  void AdoptResults(vtkFieldData* fd);
   void ResetResults();
   int RejectInput(vtkPolyData* input, vtkPolyData* cage);
   int Fail(const std::string& status, const std::string& message, vtkPolyData* cage);
