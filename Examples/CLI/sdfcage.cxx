@@ -34,6 +34,7 @@
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
+#include <future>
 #include <iostream>
 #include <new>
 #include <string>
@@ -650,11 +651,34 @@ vtkSmartPointer<vtkPolyData> readInput(
   else
   {
     progress->step("reading " + std::filesystem::path(o.Input).filename().string(), 0.0);
+    // Read on a worker thread so that a Ctrl-C answers at once even inside a reader that does
+    // not poll for it (VTK's OBJ reader): reading writes nothing, so the reader can simply be
+    // abandoned; the readers that can stop (ours, and VTK's that poll AbortExecute) do.
     std::string error;
-    input = readMesh(o.Input, error);
+    auto reading = std::async(std::launch::async,
+      [&o, &error] { return readMesh(o.Input, error, [] { return InterruptRequested != 0; }); });
+    while (reading.wait_for(std::chrono::milliseconds(20)) != std::future_status::ready)
+    {
+      if (InterruptRequested)
+      {
+        progress->finish();
+        printError("interrupted");
+        r.Status = "Cancelled";
+        r.ErrorMessage = "interrupted";
+        finish(o, r, ExitInterrupted);
+        std::fflush(stdout);
+        std::fflush(stderr);
+        std::_Exit(ExitInterrupted); // the reader thread is abandoned with the process
+      }
+    }
+    input = reading.get();
     if (!input)
     {
       progress->finish();
+      if (InterruptRequested)
+      {
+        return nullptr; // run() reports the interruption
+      }
       printError(error);
       r.Status = "UnreadableInput";
       r.ErrorMessage = error;
@@ -719,13 +743,39 @@ void configureFilter(vtkSDFCageFilter* filter, const Options& o, RunReport& r)
   r.Sign = o.Sign;
 }
 
-/// --- run: the filter, with the progress bar; the first Ctrl-C cancels it cleanly.
+/// --- run: the filter, with the progress bar; a Ctrl-C (handler installed by run()) cancels it
+/// cleanly at its next progress report.
 void runFilter(vtkSDFCageFilter* filter, ProgressBar* progress)
 {
   filter->AddObserver(vtkCommand::ProgressEvent, progress);
-  std::signal(SIGINT, onInterrupt);
   filter->Update();
-  std::signal(SIGINT, SIG_DFL);
+}
+
+/// An interruption before or between the steps: exit code 130, nothing written.
+int interrupted(const Options& o, RunReport& r, ProgressBar* progress)
+{
+  progress->finish();
+  printError("interrupted");
+  r.Status = "Cancelled";
+  r.ErrorMessage = "interrupted";
+  return finish(o, r, ExitInterrupted);
+}
+
+/// Every file the run will write can be written: checked before anything is read or computed.
+bool checkOutputs(const Options& o, RunReport& r)
+{
+  for (const std::string* path : { &o.Output, &o.Report, &o.Screenshot })
+  {
+    std::string error;
+    if (!path->empty() && !checkWritable(*path, error))
+    {
+      printError(error);
+      r.Status = "UnwritableOutput";
+      r.ErrorMessage = error;
+      return false;
+    }
+  }
+  return true;
 }
 
 /// --- results: the filter's status and every result of its table (by name), the mesh sizes.
@@ -865,10 +915,19 @@ int run(const Options& o, MessageCollector* messages)
       return finish(o, r, ExitFailure);
     }
   }
+  if (!checkOutputs(o, r))
+  {
+    // the report itself may be what cannot be written: finish() then says so too
+    return finish(o, r, ExitUnusable);
+  }
   vtkNew<ProgressBar> progress;
   progress->Enabled = !o.Quiet && isatty(STDERR_FILENO);
 
   vtkSmartPointer<vtkPolyData> input = readInput(o, r, progress, messages);
+  if (InterruptRequested)
+  {
+    return interrupted(o, r, progress);
+  }
   if (!input)
   {
     return finish(o, r, ExitUnusable);
@@ -876,6 +935,10 @@ int run(const Options& o, MessageCollector* messages)
   vtkNew<vtkSDFCageFilter> filter;
   filter->SetInputData(input);
   configureFilter(filter, o, r);
+  if (InterruptRequested)
+  {
+    return interrupted(o, r, progress);
+  }
   runFilter(filter, progress);
   collectResults(filter, r);
   const std::vector<std::string> filterErrors = takeFilterMessages(messages, o.Quiet, progress);
@@ -926,6 +989,9 @@ int run(const Options& o, MessageCollector* messages)
 
 int main(int argc, char* argv[])
 {
+  // Ctrl-C from here on: the first one stops the run cleanly (checked while reading, at every
+  // progress report of the filter and between the steps; exit code 130), a second one kills.
+  std::signal(SIGINT, onInterrupt);
   try
   {
     MessageCollector* messages = MessageCollector::install();
