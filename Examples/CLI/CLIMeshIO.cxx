@@ -2,7 +2,7 @@
 #include "CLIMeshIO.h"
 
 #include "CLIMessages.h"
-#include "CLIPLY.h"
+#include "CLIParsers.h"
 
 #include "Mesh/Shapes.h" // sdfcage::makeBuiltinShape (Core)
 
@@ -10,7 +10,6 @@
 #include <vtkCellArray.h>
 #include <vtkIdTypeArray.h>
 #include <vtkNew.h>
-#include <vtkOBJReader.h>
 #include <vtkOBJWriter.h>
 #include <vtkOFFReader.h>
 #include <vtkOFFWriter.h>
@@ -75,7 +74,7 @@ bool slurp(const std::string& path, std::string& bytes)
   return !in.bad();
 }
 
-vtkSmartPointer<vtkPolyData> toPolyData(const PLYMesh& ply)
+vtkSmartPointer<vtkPolyData> toPolyData(const ParsedMesh& ply)
 {
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
@@ -312,29 +311,27 @@ vtkSmartPointer<vtkPolyData> readMesh(
     reader->SetFileName(path.c_str());
     run(reader);
   }
-  else if (ext == ".obj")
+  else if (ext == ".obj" || ext == ".ply")
   {
-    vtkNew<vtkOBJReader> reader;
-    reader->SetFileName(path.c_str());
-    run(reader);
-  }
-  else if (ext == ".ply")
-  {
-    // our own parser: vtkPLYReader trusts the header's counts (see CLIPLY.h)
+    // our own parsers: vtkPLYReader trusts the header's counts, vtkOBJReader reads bad numbers
+    // as other numbers (see CLIParsers.h)
     std::string bytes;
     if (!slurp(path, bytes))
     {
       error = "cannot read '" + path + "': read error";
       return nullptr;
     }
-    PLYMesh ply;
+    ParsedMesh parsed;
     std::string why;
-    if (!parsePLY(bytes.data(), bytes.size(), ply, why, cancelled))
+    const bool ok = ext == ".ply" ? parsePLY(bytes.data(), bytes.size(), parsed, why, cancelled)
+                                  : parseOBJ(bytes.data(), bytes.size(), parsed, why, cancelled);
+    if (!ok)
     {
-      error = "cannot read '" + path + "': " + why;
+      error = why == "interrupted" ? why : "cannot read '" + path + "': " + why;
       return nullptr;
     }
-    mesh = toPolyData(ply);
+    bytes = std::string();
+    mesh = toPolyData(parsed);
   }
   else if (ext == ".stl")
   {

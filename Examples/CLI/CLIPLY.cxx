@@ -1,5 +1,5 @@
-// SDFCage — CLI: see CLIPLY.h.
-#include "CLIPLY.h"
+// SDFCage — CLI: the PLY parser (see CLIParsers.h).
+#include "CLIParsers.h"
 
 #include <cerrno>
 #include <cmath>
@@ -114,6 +114,19 @@ public:
   }
 
   std::size_t remaining() const { return this->Size - this->Pos; }
+
+  /// Anything but white space left (a final line feed after binary data is tolerated).
+  bool trailingData() const
+  {
+    for (std::size_t i = this->Pos; i < this->Size; ++i)
+    {
+      if (!std::strchr(" \t\r\n\v\f", this->Data[i]) || this->Data[i] == '\0')
+      {
+        return true;
+      }
+    }
+    return false;
+  }
 
   /// The fewest bytes a value of `t` takes: its size in binary; in ASCII one character and a
   /// separator (the last value of the file may lack the separator: callers allow one byte).
@@ -268,13 +281,13 @@ std::string lineOf(const char* data, std::size_t size, std::size_t& pos)
 
 } // namespace
 
-bool parsePLY(const char* data, std::size_t size, PLYMesh& mesh, std::string& error,
+bool parsePLY(const char* data, std::size_t size, ParsedMesh& mesh, std::string& error,
   const std::function<bool()>& cancelled)
 {
-  mesh = PLYMesh();
+  mesh = ParsedMesh();
   auto fail = [&error, &mesh](const std::string& why) {
     error = why;
-    mesh = PLYMesh();
+    mesh = ParsedMesh();
     return false;
   };
   if (size == 0)
@@ -510,6 +523,15 @@ bool parsePLY(const char* data, std::size_t size, PLYMesh& mesh, std::string& er
         mesh.Points.insert(mesh.Points.end(), point, point + 3);
       }
     }
+  }
+  // what the header declared must be all there is: bytes left mean it claims less than the
+  // file holds (trailing white space is fine)
+  if (body.trailingData())
+  {
+    std::ostringstream m;
+    m << body.remaining() << " bytes are left after the elements the header declares: the header does not match "
+      << "the data";
+    return fail(m.str());
   }
   return true;
 }

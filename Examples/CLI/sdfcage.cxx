@@ -29,6 +29,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -849,13 +850,48 @@ int stopCode(const Options& o, RunReport& r, const std::vector<std::string>& fil
   return -1;
 }
 
+/// PLY and STL store coordinates as 32-bit floats. Rounding moves every point of the cage by at
+/// most the largest vertex move, so the verified clearance survives when that move is a small
+/// part of it (at most a tenth); far from the origin (1e12 away, say) it is not: then nothing
+/// is written and the message says which formats keep doubles.
+bool fitsSinglePrecision(vtkPolyData* cage, const std::string& path, double clearance, std::string& error)
+{
+  const std::string ext = lowerExtension(path);
+  if (ext != ".ply" && ext != ".stl")
+  {
+    return true;
+  }
+  double largest = 0.0;
+  for (vtkIdType i = 0; i < cage->GetNumberOfPoints(); ++i)
+  {
+    double p[3];
+    cage->GetPoint(i, p);
+    double moved = 0.0;
+    for (double c : p)
+    {
+      const double d = c - static_cast<double>(static_cast<float>(c));
+      moved += d * d;
+    }
+    largest = std::max(largest, std::sqrt(moved));
+  }
+  if (!(largest <= 0.1 * clearance))
+  {
+    error = "cannot write '" + path + "': single precision (" + ext + " stores 32-bit floats) would move the cage by up to " +
+      shortNumber(largest) + ", more than a tenth of its clearance " + shortNumber(clearance) +
+      " (input far from the origin?): write .vtp, .vtk, .off or .obj, which keep doubles";
+    return false;
+  }
+  return true;
+}
+
 /// --- write: the cage file. False (with the status in `r`) when it cannot be written.
 bool writeCage(vtkPolyData* cage, const Options& o, RunReport& r, ProgressBar* progress)
 {
   const Clock::time_point start = Clock::now();
   progress->step("writing " + std::filesystem::path(o.Output).filename().string(), 1.0);
   std::string error;
-  if (!writeMesh(cage, o.Output, error))
+  if (!fitsSinglePrecision(cage, o.Output, r.number("MeasuredClearance"), error) ||
+    !writeMesh(cage, o.Output, error))
   {
     progress->finish();
     printError(error);
