@@ -119,6 +119,7 @@ sdfcage::CageOptions CageOptionsOf(vtkSDFCageFilter* f)
   options.Envelope.Adaptivity = f->GetAdaptivity();
   options.Envelope.MaximumRefinements = f->GetMaximumRefinements();
   options.MaximumEnvelopeWidenings = f->GetMaximumEnvelopeWidenings();
+  options.Envelope.MemoryLimit = static_cast<std::size_t>(f->GetMemoryLimit() * 1048576.0);
   options.Envelope.KeepDistanceField = f->GetGenerateDistanceField() != 0;
   options.Envelope.UseActivePoints = f->GetUseActivePoints() != 0;
   options.Envelope.ActivePoints.Radius = f->GetActiveRadius();
@@ -336,6 +337,7 @@ void vtkSDFCageFilter::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Adaptivity: " << this->Adaptivity << "\n";
   os << indent << "MaximumRefinements: " << this->MaximumRefinements << "\n";
   os << indent << "MaximumEnvelopeWidenings: " << this->MaximumEnvelopeWidenings << "\n";
+  os << indent << "MemoryLimit: " << this->MemoryLimit << " MiB (0 = automatic)\n";
   os << indent << "UseActivePoints: " << (this->UseActivePoints ? "On" : "Off") << "\n";
   os << indent << "ActiveRadius: " << this->ActiveRadius << "\n";
   os << indent << "GeodesicThreshold: " << this->GeodesicThreshold << "\n";

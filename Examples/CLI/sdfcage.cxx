@@ -94,6 +94,10 @@ void printUsage(std::ostream& os)
         "      --widenings N       inputs without a defined topology (open, soups) whose target is\n"
         "                          not reached: rebuild the envelope at twice the isovalue up to N\n"
         "                          times and keep the closest cage, default 3; 0 = off\n"
+        "      --memory-limit MB   memory budget of the envelope (distance grid, isosurface,\n"
+        "                          verification), estimated before each grid is built: over it the\n"
+        "                          run stops with the need named (exit 3); default 0 = automatic\n"
+        "                          (three quarters of the physical memory)\n"
         "      --sign S            how the inside of the input is decided: auto (default: flood for\n"
         "                          a closed, consistently oriented mesh, winding otherwise), flood,\n"
         "                          winding (generalized winding number: holes bridged, sheets\n"
@@ -143,6 +147,7 @@ struct Options
   int Vertices = -1;        ///< -1 = the filter's default
   int Refinements = -1;     ///< -1 = the filter's default
   int Widenings = -1;       ///< -1 = the filter's default
+  double MemoryLimit = 0.0; ///< MiB, 0 = automatic (3/4 of the physical memory)
   bool NoActivePoints = false;
   double ActiveRadius = -1.0;      ///< -1 = the filter's default
   double GeodesicThreshold = -1.0; ///< -1 = the filter's default
@@ -353,6 +358,8 @@ bool parseBuildOption(ArgumentCursor& a, Options& o, vtkSDFCageFilter* limits)
     o.Adaptivity = a.number(limits->GetAdaptivityMinValue(), limits->GetAdaptivityMaxValue());
   else if (arg == "--refinements")
     o.Refinements = a.integer(limits->GetMaximumRefinementsMinValue(), limits->GetMaximumRefinementsMaxValue());
+  else if (arg == "--memory-limit")
+    o.MemoryLimit = a.number(limits->GetMemoryLimitMinValue(), limits->GetMemoryLimitMaxValue());
   else if (arg == "--widenings")
     o.Widenings =
       a.integer(limits->GetMaximumEnvelopeWideningsMinValue(), limits->GetMaximumEnvelopeWideningsMaxValue());
@@ -709,6 +716,7 @@ void configureFilter(vtkSDFCageFilter* filter, const Options& o, RunReport& r)
     filter->SetMaximumRefinements(o.Refinements);
   if (o.Widenings >= 0)
     filter->SetMaximumEnvelopeWidenings(o.Widenings);
+  filter->SetMemoryLimit(o.MemoryLimit);
   filter->SetUseActivePoints(o.NoActivePoints ? 0 : 1);
   if (o.ActiveRadius >= 0)
     filter->SetActiveRadius(o.ActiveRadius);
