@@ -12,6 +12,7 @@ set -euo pipefail
 #    --screenshot (ParaView's VTK links them through imported targets that only exist with the
 #    -dev packages).
 #  - libcgal-dev libgtest-dev: exact-predicate cross-checks and unit tests (tests only).
+#  - clang libclang-rt-14-dev: libFuzzer and the sanitizers' runtimes for .ci/fuzz.sh (tests only).
 packages=(
   cmake ninja-build g++ ccache
   libeigen3-dev libtbb-dev libopenvdb-dev libboost-iostreams-dev
@@ -19,7 +20,7 @@ packages=(
   libglew-dev libfreetype-dev libx11-dev
   xvfb xauth
 )
-test_packages=(libcgal-dev libgtest-dev)
+test_packages=(libcgal-dev libgtest-dev clang libclang-rt-14-dev)
 
 case "${1:-}" in
   "") ;;
