@@ -12,6 +12,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${FUZZ_SECONDS:-45}"
 flags="-O1 -g -fno-omit-frame-pointer -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined"
+flags+=" -fsanitize-ignorelist=$PWD/Testing/Fuzz/ubsan_ignore.txt"
 
 CC=clang CXX=clang++ cmake -S Testing/Fuzz -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=None \
   "-DCMAKE_C_FLAGS=$flags" "-DCMAKE_CXX_FLAGS=$flags"
@@ -20,6 +21,7 @@ cmake --build build-fuzz -j2
 mkdir -p build-fuzz/artifacts
 export ASAN_OPTIONS="detect_leaks=1:allocator_may_return_null=1"
 export UBSAN_OPTIONS="print_stacktrace=1"
+export LSAN_OPTIONS="suppressions=$PWD/Testing/Fuzz/lsan.supp:print_suppressions=0"
 status=0
 for harness in fuzz_mesh_parsers fuzz_off_reader fuzz_cli_read fuzz_core_pipeline; do
   exe="build-fuzz/$harness"

@@ -22,6 +22,7 @@
 #include <vtkSTLWriter.h>
 #include <vtkXMLPolyDataReader.h>
 #include <vtkXMLPolyDataWriter.h>
+#include <vtksys/SystemTools.hxx>
 
 #include <algorithm>
 #include <cctype>
@@ -193,23 +194,19 @@ bool checkLegacyCounts(const std::string& bytes, std::string& why)
   return true;
 }
 
-/// Binary STL (a file not starting with "solid"): 80 bytes of header, the triangle count, 50
-/// bytes a triangle.
+/// Binary STL: 80 bytes of header, the triangle count, 50 bytes a triangle. Whether the file is
+/// binary is decided as vtkSTLReader decides it (vtksys' DetectFileType on the first bytes, also
+/// for a file that starts with "solid"), so that the count it would trust is checked.
 bool checkBinarySTL(const std::string& path, std::uintmax_t size, std::string& why)
 {
+  if (vtksys::SystemTools::DetectFileType(path.c_str()) == vtksys::SystemTools::FileTypeText)
+  {
+    return true; // read as ASCII by VTK
+  }
   std::ifstream in(path, std::ios::binary);
   char head[84] = {};
   in.read(head, sizeof(head));
   const std::streamsize got = in.gcount();
-  std::size_t first = 0;
-  while (first < static_cast<std::size_t>(got) && std::isspace(static_cast<unsigned char>(head[first])))
-  {
-    ++first;
-  }
-  if (got >= 5 + static_cast<std::streamsize>(first) && std::strncmp(head + first, "solid", 5) == 0)
-  {
-    return true; // ASCII (or a binary file that says "solid": VTK's reader tells them apart)
-  }
   if (got < 84)
   {
     why = "a binary STL file needs at least 84 bytes (header and triangle count), this one has " +

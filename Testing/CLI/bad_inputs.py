@@ -235,6 +235,9 @@ CASES = {
     "lying_ply_fewer_faces": ("m.ply", ply_binary(CUBE_POINTS, CUBE_TRIANGLES, nf=10), [], 2, "header does not match",
                               {}),
     "lying_stl_header": ("m.stl", stl_binary(CUBE_POINTS, CUBE_TRIANGLES[:10], count=12), [], 2, "declares", {}),
+    # starts like ASCII ("solid") but VTK reads it as binary (found by fuzz_cli_read: it then
+    # trusted a count of 2.2 billion triangles made of text bytes)
+    "stl_solid_read_as_binary": ("m.stl", b"solid c\n" + b"\x83" * 200, [], 2, "declares", {}),
     "lying_stl_header_short": ("m.stl", stl_binary(CUBE_POINTS, CUBE_TRIANGLES, count=3), ["-n", "30"], 0, None,
                                {"check": True}),
     # files that are not meshes at all
