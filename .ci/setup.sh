@@ -13,6 +13,7 @@ set -euo pipefail
 #    -dev packages).
 #  - libcgal-dev libgtest-dev: exact-predicate cross-checks and unit tests (tests only).
 #  - tetgen: the test that TetGen meshes the space between a cage and its input (tests only).
+#  - clang libclang-rt-14-dev: libFuzzer and the sanitizers' runtimes for .ci/fuzz.sh (tests only).
 packages=(
   cmake ninja-build g++ ccache
   libeigen3-dev libtbb-dev libopenvdb-dev libboost-iostreams-dev
@@ -20,7 +21,7 @@ packages=(
   libglew-dev libfreetype-dev libx11-dev
   xvfb xauth
 )
-test_packages=(libcgal-dev libgtest-dev tetgen)
+test_packages=(libcgal-dev libgtest-dev tetgen clang libclang-rt-14-dev)
 
 case "${1:-}" in
   "") ;;

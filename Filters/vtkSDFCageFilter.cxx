@@ -124,6 +124,7 @@ sdfcage::CageOptions CageOptionsOf(vtkSDFCageFilter* f)
   options.MaximumEnvelopeWidenings = f->GetMaximumEnvelopeWidenings();
   options.Envelope.MaximumTopologyRepairs = f->GetMaximumTopologyRepairs();
   options.Envelope.RequireTopology = f->GetRequireTopology() != 0;
+  options.Envelope.MemoryLimit = static_cast<std::size_t>(f->GetMemoryLimit() * 1048576.0);
   options.Envelope.KeepDistanceField = f->GetGenerateDistanceField() != 0;
   options.Envelope.UseActivePoints = f->GetUseActivePoints() != 0;
   options.Envelope.ActivePoints.Radius = f->GetActiveRadius();
@@ -373,6 +374,7 @@ void vtkSDFCageFilter::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "MaximumEnvelopeWidenings: " << this->MaximumEnvelopeWidenings << "\n";
   os << indent << "MaximumTopologyRepairs: " << this->MaximumTopologyRepairs << "\n";
   os << indent << "RequireTopology: " << this->RequireTopology << "\n";
+  os << indent << "MemoryLimit: " << this->MemoryLimit << " MiB (0 = automatic)\n";
   os << indent << "UseActivePoints: " << (this->UseActivePoints ? "On" : "Off") << "\n";
   os << indent << "ActiveRadius: " << this->ActiveRadius << "\n";
   os << indent << "GeodesicThreshold: " << this->GeodesicThreshold << "\n";

@@ -232,6 +232,17 @@ public:
 
   ///@{
   /**
+   * Memory budget of the envelope in MiB (its distance grid, isosurface and verification, as
+   * estimated before each grid is built): a grid whose need exceeds it is not built; the run
+   * stops with an error naming the need (status Failed), and a finer refinement grid over it is
+   * not tried. 0 (default) = three quarters of the machine's physical memory.
+   */
+  vtkSetClampMacro(MemoryLimit, double, 0.0, 1.0e12);
+  vtkGetMacro(MemoryLimit, double);
+  ///@}
+
+  ///@{
+  /**
    * Shape-aware envelope (paper §3.1), on by default: points of the input that have another
    * surface point closer than ActiveRadius but farther than GeodesicThreshold along the surface
    * (nearly touching parts: fingers, legs, separate components) are "active", and the SDF is
@@ -403,6 +414,7 @@ protected:
   int MaximumEnvelopeWidenings;
   int MaximumTopologyRepairs;
   vtkTypeBool RequireTopology;
+  double MemoryLimit = 0.0;
   vtkTypeBool GenerateDistanceField;
   int NumberOfThreads;
   vtkTypeBool UseActivePoints;

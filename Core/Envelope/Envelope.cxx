@@ -529,6 +529,23 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
   const int levels = 1 + std::max(0, options.MaximumRefinements);
   for (int level = 0; level < levels; ++level, h *= 0.5)
   {
+    // the memory budget, before the grid is built (MemoryBudget.h)
+    const std::size_t need = estimateEnvelopeBytes(unitInput, h, c, flood, options.KeepDistanceField);
+    if (need > options.memoryLimit())
+    {
+      std::ostringstream m;
+      m << "the envelope at voxel size " << h << " needs about " << formatBytes(need)
+        << " of memory (distance grid, isosurface and verification, estimated), more than the memory limit of "
+        << formatBytes(options.memoryLimit());
+      if (level == 0)
+      {
+        result.State = Status::Failed;
+        result.Message = m.str() + ": use a larger VoxelSize or IsoValue, or raise MemoryLimit";
+        return result;
+      }
+      result.Message += " (no finer grid tried: " + m.str() + ")";
+      break;
+    }
     std::vector<double> adaptivities{ 0.0 };
     if (level == 0 && options.Adaptivity > 0)
     {

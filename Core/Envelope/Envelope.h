@@ -2,6 +2,7 @@
 // amplified field, isosurface, trapped pockets removed, then verified (Quality/Verification.h).
 #pragma once
 
+#include "Common/MemoryBudget.h"
 #include "Common/Status.h"
 #include "Envelope/ActivePoints.h"
 #include "Mesh/Mesh.h"
@@ -91,8 +92,14 @@ struct EnvelopeOptions
   /// Fail (Status::TopologyChanged, no envelope) instead of accepting an envelope whose genus
   /// or number of parts differs from the closed input's after the repairs.
   bool RequireTopology = false;
+  /// Memory budget in bytes: an envelope whose estimated need (estimateEnvelopeBytes) exceeds it
+  /// is not built (Status::Failed, the message names the need and the limit), and a finer
+  /// refinement grid over it is not tried. 0 = defaultMemoryLimit(), three quarters of the
+  /// machine's physical memory.
+  std::size_t MemoryLimit = 0;
 
   double voxelSize() const { return VoxelSize > 0 ? VoxelSize : IsoValue / 2; }
+  std::size_t memoryLimit() const { return MemoryLimit > 0 ? MemoryLimit : defaultMemoryLimit(); }
   double clearance() const { return MinimumClearance > 0 ? MinimumClearance : IsoValue / 4; }
 };
 

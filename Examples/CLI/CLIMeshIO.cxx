@@ -2,17 +2,17 @@
 #include "CLIMeshIO.h"
 
 #include "CLIMessages.h"
+#include "CLIParsers.h"
 
 #include "Mesh/Shapes.h" // sdfcage::makeBuiltinShape (Core)
 
+#include <vtkCallbackCommand.h>
 #include <vtkCellArray.h>
 #include <vtkIdTypeArray.h>
 #include <vtkNew.h>
-#include <vtkOBJReader.h>
 #include <vtkOBJWriter.h>
 #include <vtkOFFReader.h>
 #include <vtkOFFWriter.h>
-#include <vtkPLYReader.h>
 #include <vtkPLYWriter.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
@@ -22,11 +22,16 @@
 #include <vtkSTLWriter.h>
 #include <vtkXMLPolyDataReader.h>
 #include <vtkXMLPolyDataWriter.h>
+#include <vtksys/SystemTools.hxx>
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 namespace fs = std::filesystem;
 
@@ -56,6 +61,169 @@ std::string firstVTKError()
   return (c && !c->errors().empty()) ? c->errors().front() : std::string();
 }
 
+/// The whole file in memory (the size was checked by the caller).
+bool slurp(const std::string& path, std::string& bytes)
+{
+  std::ifstream in(path, std::ios::binary);
+  if (!in)
+  {
+    return false;
+  }
+  std::ostringstream buffer;
+  buffer << in.rdbuf();
+  bytes = buffer.str();
+  return !in.bad();
+}
+
+vtkSmartPointer<vtkPolyData> toPolyData(const ParsedMesh& ply)
+{
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  const vtkIdType n = static_cast<vtkIdType>(ply.Points.size() / 3);
+  points->SetNumberOfPoints(n);
+  for (vtkIdType i = 0; i < n; ++i)
+  {
+    points->SetPoint(i, ply.Points.data() + 3 * i);
+  }
+  vtkNew<vtkIdTypeArray> offsets;
+  vtkNew<vtkIdTypeArray> connectivity;
+  offsets->SetNumberOfValues(static_cast<vtkIdType>(ply.Offsets.size()));
+  for (std::size_t i = 0; i < ply.Offsets.size(); ++i)
+  {
+    offsets->SetValue(static_cast<vtkIdType>(i), static_cast<vtkIdType>(ply.Offsets[i]));
+  }
+  connectivity->SetNumberOfValues(static_cast<vtkIdType>(ply.Connectivity.size()));
+  for (std::size_t i = 0; i < ply.Connectivity.size(); ++i)
+  {
+    connectivity->SetValue(static_cast<vtkIdType>(i), static_cast<vtkIdType>(ply.Connectivity[i]));
+  }
+  vtkNew<vtkCellArray> polys;
+  polys->SetData(offsets, connectivity);
+  vtkSmartPointer<vtkPolyData> mesh = vtkSmartPointer<vtkPolyData>::New();
+  mesh->SetPoints(points);
+  mesh->SetPolys(polys);
+  return mesh;
+}
+
+/// Legacy VTK files: every count a section header declares (POINTS n, POLYGONS n size, ...,
+/// POINT_DATA n, field arrays "name components tuples type") must fit in the file (at least
+/// two bytes a value in ASCII, one in binary) before vtkPolyDataReader allocates for it: a
+/// header claiming a billion points made it allocate and loop for minutes.
+bool checkLegacyCounts(const std::string& bytes, std::string& why)
+{
+  const double size = static_cast<double>(bytes.size());
+  bool binary = false;
+  std::size_t pos = 0;
+  int lineNumber = 0;
+  while (pos < bytes.size())
+  {
+    std::size_t end = bytes.find('\n', pos);
+    if (end == std::string::npos)
+    {
+      end = bytes.size();
+    }
+    const std::string line = bytes.substr(pos, std::min<std::size_t>(end - pos, 256));
+    pos = end + 1;
+    ++lineNumber;
+    if (lineNumber == 3)
+    {
+      binary = line.compare(0, 6, "BINARY") == 0;
+    }
+    std::istringstream in(line);
+    std::string keyword;
+    in >> keyword;
+    const double perValue = binary ? 1.0 : 2.0;
+    auto tooLarge = [&](double values, const std::string& what) {
+      if (values * perValue <= size + 1.0)
+      {
+        return false;
+      }
+      std::ostringstream m;
+      m << "line " << lineNumber << " declares " << what << ", more than a file of " << bytes.size()
+        << " bytes can hold";
+      why = m.str();
+      return true;
+    };
+    if (keyword == "POINTS" || keyword == "POINT_DATA" || keyword == "CELL_DATA")
+    {
+      double n = -1;
+      if (!(in >> n) || n < 0)
+      {
+        why = "line " + std::to_string(lineNumber) + ": " + keyword + " needs a non-negative count";
+        return false;
+      }
+      if (tooLarge(keyword == "POINTS" ? 3 * n : n, std::to_string(static_cast<long long>(n)) + " " +
+              (keyword == "POINTS" ? "points" : "data tuples")))
+      {
+        return false;
+      }
+    }
+    else if (keyword == "VERTICES" || keyword == "LINES" || keyword == "POLYGONS" || keyword == "TRIANGLE_STRIPS")
+    {
+      double n = -1, values = -1;
+      if (!(in >> n >> values) || n < 0 || values < 0)
+      {
+        why = "line " + std::to_string(lineNumber) + ": " + keyword + " needs two non-negative counts";
+        return false;
+      }
+      if (tooLarge(std::max(n, values), std::to_string(static_cast<long long>(n)) + " cells of " +
+              std::to_string(static_cast<long long>(values)) + " values"))
+      {
+        return false;
+      }
+    }
+    else if (!keyword.empty())
+    {
+      // a field array: "name components tuples type"
+      double components = -1, tuples = -1;
+      std::string type, extra;
+      if ((in >> components >> tuples >> type) && !(in >> extra) && components >= 0 && tuples >= 0 &&
+        (type == "float" || type == "double" || type == "int" || type == "vtkIdType" || type == "char" ||
+          type == "unsigned_char" || type == "short" || type == "unsigned_short" || type == "unsigned_int" ||
+          type == "long" || type == "unsigned_long" || type == "vtktypeint64" || type == "vtktypeuint64" ||
+          type == "bit" || type == "string"))
+      {
+        if (tooLarge(components * tuples, "an array of " + std::to_string(static_cast<long long>(tuples)) +
+                " tuples"))
+        {
+          return false;
+        }
+      }
+    }
+  }
+  return true;
+}
+
+/// Binary STL: 80 bytes of header, the triangle count, 50 bytes a triangle. Whether the file is
+/// binary is decided as vtkSTLReader decides it (vtksys' DetectFileType on the first bytes, also
+/// for a file that starts with "solid"), so that the count it would trust is checked.
+bool checkBinarySTL(const std::string& path, std::uintmax_t size, std::string& why)
+{
+  if (vtksys::SystemTools::DetectFileType(path.c_str()) == vtksys::SystemTools::FileTypeText)
+  {
+    return true; // read as ASCII by VTK
+  }
+  std::ifstream in(path, std::ios::binary);
+  char head[84] = {};
+  in.read(head, sizeof(head));
+  const std::streamsize got = in.gcount();
+  if (got < 84)
+  {
+    why = "a binary STL file needs at least 84 bytes (header and triangle count), this one has " +
+      std::to_string(size);
+    return false;
+  }
+  const auto* b = reinterpret_cast<const unsigned char*>(head + 80);
+  const std::uint64_t count = b[0] | (b[1] << 8) | (b[2] << 16) | (static_cast<std::uint64_t>(b[3]) << 24);
+  if (84 + 50 * count > size)
+  {
+    why = "the binary STL header declares " + std::to_string(count) + " triangles (" +
+      std::to_string(84 + 50 * count) + " bytes), the file has " + std::to_string(size) + " bytes";
+    return false;
+  }
+  return true;
+}
+
 } // namespace
 
 const char* supportedExtensions()
@@ -77,12 +245,18 @@ bool isSupportedExtension(const std::string& path)
   return ext == ".off" || ext == ".obj" || ext == ".ply" || ext == ".stl" || ext == ".vtp" || ext == ".vtk";
 }
 
-vtkSmartPointer<vtkPolyData> readMesh(const std::string& path, std::string& error)
+vtkSmartPointer<vtkPolyData> readMesh(
+  const std::string& path, std::string& error, const std::function<bool()>& cancelled)
 {
   std::error_code ec;
   if (!fs::exists(path, ec))
   {
     error = "cannot read '" + path + "': no such file";
+    return nullptr;
+  }
+  if (fs::is_directory(path, ec))
+  {
+    error = "cannot read '" + path + "': it is a folder, not a mesh file";
     return nullptr;
   }
   if (!fs::is_regular_file(path, ec))
@@ -101,48 +275,73 @@ vtkSmartPointer<vtkPolyData> readMesh(const std::string& path, std::string& erro
       "' (supported: " + supportedExtensions() + ")";
     return nullptr;
   }
+  const std::uintmax_t fileSize = fs::file_size(path, ec);
+  if (ec || fileSize == 0)
+  {
+    error = "cannot read '" + path + "': the file is empty";
+    return nullptr;
+  }
 
   clearMessages();
   const std::string ext = lowerExtension(path);
   vtkSmartPointer<vtkPolyData> mesh;
   unsigned long errorCode = 0;
+  // VTK's readers that poll AbortExecute stop early on Ctrl-C (the caller checks afterwards).
+  vtkNew<vtkCallbackCommand> abortOnCancel;
+  abortOnCancel->SetClientData(const_cast<std::function<bool()>*>(&cancelled));
+  abortOnCancel->SetCallback([](vtkObject* caller, unsigned long, void* clientData, void*) {
+    const auto* cancel = static_cast<const std::function<bool()>*>(clientData);
+    if (*cancel && (*cancel)())
+    {
+      static_cast<vtkAlgorithm*>(caller)->SetAbortExecute(1);
+    }
+  });
+  auto run = [&](vtkAlgorithm* reader) {
+    reader->AddObserver(vtkCommand::ProgressEvent, abortOnCancel);
+    reader->Update();
+    errorCode = reader->GetErrorCode();
+    mesh = vtkPolyData::SafeDownCast(reader->GetOutputDataObject(0));
+  };
   if (ext == ".off")
   {
     vtkNew<vtkOFFReader> reader;
     reader->SetFileName(path.c_str());
-    reader->Update();
-    errorCode = reader->GetErrorCode();
-    mesh = reader->GetOutput();
+    run(reader);
   }
-  else if (ext == ".obj")
+  else if (ext == ".obj" || ext == ".ply")
   {
-    vtkNew<vtkOBJReader> reader;
-    reader->SetFileName(path.c_str());
-    reader->Update();
-    errorCode = reader->GetErrorCode();
-    mesh = reader->GetOutput();
-  }
-  else if (ext == ".ply")
-  {
-    vtkNew<vtkPLYReader> reader;
-    if (!reader->CanReadFile(path.c_str()))
+    // our own parsers: vtkPLYReader trusts the header's counts, vtkOBJReader reads bad numbers
+    // as other numbers (see CLIParsers.h)
+    std::string bytes;
+    if (!slurp(path, bytes))
     {
-      error = "cannot read '" + path + "': not a PLY file";
+      error = "cannot read '" + path + "': read error";
       return nullptr;
     }
-    reader->SetFileName(path.c_str());
-    reader->Update();
-    errorCode = reader->GetErrorCode();
-    mesh = reader->GetOutput();
+    ParsedMesh parsed;
+    std::string why;
+    const bool ok = ext == ".ply" ? parsePLY(bytes.data(), bytes.size(), parsed, why, cancelled)
+                                  : parseOBJ(bytes.data(), bytes.size(), parsed, why, cancelled);
+    if (!ok)
+    {
+      error = why == "interrupted" ? why : "cannot read '" + path + "': " + why;
+      return nullptr;
+    }
+    bytes = std::string();
+    mesh = toPolyData(parsed);
   }
   else if (ext == ".stl")
   {
+    std::string why;
+    if (!checkBinarySTL(path, fileSize, why))
+    {
+      error = "cannot read '" + path + "': " + why;
+      return nullptr;
+    }
     vtkNew<vtkSTLReader> reader;
     reader->SetFileName(path.c_str());
     reader->MergingOn(); // STL stores triangle soup: merge coincident points to get a surface
-    reader->Update();
-    errorCode = reader->GetErrorCode();
-    mesh = reader->GetOutput();
+    run(reader);
   }
   else if (ext == ".vtp")
   {
@@ -153,12 +352,23 @@ vtkSmartPointer<vtkPolyData> readMesh(const std::string& path, std::string& erro
       return nullptr;
     }
     reader->SetFileName(path.c_str());
-    reader->Update();
-    errorCode = reader->GetErrorCode();
-    mesh = reader->GetOutput();
+    run(reader);
   }
   else // ".vtk"
   {
+    std::string bytes;
+    std::string why;
+    if (!slurp(path, bytes))
+    {
+      error = "cannot read '" + path + "': read error";
+      return nullptr;
+    }
+    if (!checkLegacyCounts(bytes, why))
+    {
+      error = "cannot read '" + path + "': " + why;
+      return nullptr;
+    }
+    bytes = std::string();
     vtkNew<vtkPolyDataReader> reader;
     reader->SetFileName(path.c_str());
     if (!reader->IsFilePolyData())
@@ -168,9 +378,12 @@ vtkSmartPointer<vtkPolyData> readMesh(const std::string& path, std::string& erro
         "first, e.g. with vtkGeometryFilter)";
       return nullptr;
     }
-    reader->Update();
-    errorCode = reader->GetErrorCode();
-    mesh = reader->GetOutput();
+    run(reader);
+  }
+  if (cancelled && cancelled())
+  {
+    error = "interrupted";
+    return nullptr;
   }
 
   const std::string vtkError = firstVTKError();
@@ -189,6 +402,43 @@ vtkSmartPointer<vtkPolyData> readMesh(const std::string& path, std::string& erro
   vtkSmartPointer<vtkPolyData> copy = vtkSmartPointer<vtkPolyData>::New();
   copy->ShallowCopy(mesh);
   return copy;
+}
+
+bool checkWritable(const std::string& path, std::string& error)
+{
+  std::error_code ec;
+  const fs::path p(path);
+  if (fs::is_directory(p, ec))
+  {
+    error = "cannot write '" + path + "': it is a folder";
+    return false;
+  }
+  const fs::path parent = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  if (!fs::exists(parent, ec))
+  {
+    error = "cannot write '" + path + "': the folder '" + parent.string() + "' does not exist";
+    return false;
+  }
+  if (!fs::is_directory(parent, ec))
+  {
+    error = "cannot write '" + path + "': '" + parent.string() + "' is not a folder";
+    return false;
+  }
+  // The only true test is to open it: an existing file for appending (nothing changes), a new
+  // one created and removed again.
+  const bool existed = fs::exists(p, ec);
+  std::FILE* f = std::fopen(path.c_str(), "ab");
+  if (!f)
+  {
+    error = "cannot write '" + path + "': " + std::strerror(errno);
+    return false;
+  }
+  std::fclose(f);
+  if (!existed)
+  {
+    fs::remove(p, ec);
+  }
+  return true;
 }
 
 bool writeMesh(vtkPolyData* mesh, const std::string& path, std::string& error)

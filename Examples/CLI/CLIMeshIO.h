@@ -3,6 +3,7 @@
 
 #include <vtkSmartPointer.h>
 
+#include <functional>
 #include <string>
 
 class vtkPolyData;
@@ -20,8 +21,17 @@ std::string lowerExtension(const std::string& path);
 bool isSupportedExtension(const std::string& path);
 
 /// Reads a surface mesh. On failure returns nullptr and a one-line reason in `error` (missing
-/// file, unknown extension, unreadable or non-polygonal content).
-vtkSmartPointer<vtkPolyData> readMesh(const std::string& path, std::string& error);
+/// file, a folder, unknown extension, empty, unreadable or non-polygonal content, a header whose
+/// counts the file cannot hold). `cancelled`, when set, is polled while reading (the readers
+/// that report progress stop early) and once after it: then the result is null and `error`
+/// "interrupted".
+vtkSmartPointer<vtkPolyData> readMesh(
+  const std::string& path, std::string& error, const std::function<bool()>& cancelled = {});
+
+/// True when `path` can be written: its folder exists and a file there can be opened for
+/// writing (an existing file is left as it is, a new one is removed again). Otherwise false with
+/// a one-line reason.
+bool checkWritable(const std::string& path, std::string& error);
 
 /// Writes `mesh` in the format of the extension of `path`. Returns false with a reason.
 bool writeMesh(vtkPolyData* mesh, const std::string& path, std::string& error);

@@ -29,11 +29,13 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
+#include <future>
 #include <iostream>
 #include <new>
 #include <string>
@@ -99,6 +101,10 @@ void printUsage(std::ostream& os)
         "                          automatic clearance), default 2; 0 = off\n"
         "      --require-topology  exit 1 and write no cage if the cage's genus or number of parts\n"
         "                          still differs from the closed input's (default: a warning)\n"
+        "      --memory-limit MB   memory budget of the envelope (distance grid, isosurface,\n"
+        "                          verification), estimated before each grid is built: over it the\n"
+        "                          run stops with the need named (exit 3); default 0 = automatic\n"
+        "                          (three quarters of the physical memory)\n"
         "      --sign S            how the inside of the input is decided: auto (default: flood for\n"
         "                          a closed, consistently oriented mesh, winding otherwise), flood,\n"
         "                          winding (generalized winding number: holes bridged, sheets\n"
@@ -150,6 +156,7 @@ struct Options
   int Widenings = -1;       ///< -1 = the filter's default
   int TopologyRepairs = -1; ///< -1 = the filter's default
   bool RequireTopology = false;
+  double MemoryLimit = 0.0; ///< MiB, 0 = automatic (3/4 of the physical memory)
   bool NoActivePoints = false;
   double ActiveRadius = -1.0;      ///< -1 = the filter's default
   double GeodesicThreshold = -1.0; ///< -1 = the filter's default
@@ -360,6 +367,8 @@ bool parseBuildOption(ArgumentCursor& a, Options& o, vtkSDFCageFilter* limits)
     o.Adaptivity = a.number(limits->GetAdaptivityMinValue(), limits->GetAdaptivityMaxValue());
   else if (arg == "--refinements")
     o.Refinements = a.integer(limits->GetMaximumRefinementsMinValue(), limits->GetMaximumRefinementsMaxValue());
+  else if (arg == "--memory-limit")
+    o.MemoryLimit = a.number(limits->GetMemoryLimitMinValue(), limits->GetMemoryLimitMaxValue());
   else if (arg == "--widenings")
     o.Widenings =
       a.integer(limits->GetMaximumEnvelopeWideningsMinValue(), limits->GetMaximumEnvelopeWideningsMaxValue());
@@ -664,11 +673,34 @@ vtkSmartPointer<vtkPolyData> readInput(
   else
   {
     progress->step("reading " + std::filesystem::path(o.Input).filename().string(), 0.0);
+    // Read on a worker thread so that a Ctrl-C answers at once even inside a reader that does
+    // not poll for it (VTK's OBJ reader): reading writes nothing, so the reader can simply be
+    // abandoned; the readers that can stop (ours, and VTK's that poll AbortExecute) do.
     std::string error;
-    input = readMesh(o.Input, error);
+    auto reading = std::async(std::launch::async,
+      [&o, &error] { return readMesh(o.Input, error, [] { return InterruptRequested != 0; }); });
+    while (reading.wait_for(std::chrono::milliseconds(20)) != std::future_status::ready)
+    {
+      if (InterruptRequested)
+      {
+        progress->finish();
+        printError("interrupted");
+        r.Status = "Cancelled";
+        r.ErrorMessage = "interrupted";
+        finish(o, r, ExitInterrupted);
+        std::fflush(stdout);
+        std::fflush(stderr);
+        std::_Exit(ExitInterrupted); // the reader thread is abandoned with the process
+      }
+    }
+    input = reading.get();
     if (!input)
     {
       progress->finish();
+      if (InterruptRequested)
+      {
+        return nullptr; // run() reports the interruption
+      }
       printError(error);
       r.Status = "UnreadableInput";
       r.ErrorMessage = error;
@@ -701,6 +733,7 @@ void configureFilter(vtkSDFCageFilter* filter, const Options& o, RunReport& r)
   if (o.TopologyRepairs >= 0)
     filter->SetMaximumTopologyRepairs(o.TopologyRepairs);
   filter->SetRequireTopology(o.RequireTopology ? 1 : 0);
+  filter->SetMemoryLimit(o.MemoryLimit);
   filter->SetUseActivePoints(o.NoActivePoints ? 0 : 1);
   if (o.ActiveRadius >= 0)
     filter->SetActiveRadius(o.ActiveRadius);
@@ -736,13 +769,39 @@ void configureFilter(vtkSDFCageFilter* filter, const Options& o, RunReport& r)
   r.Sign = o.Sign;
 }
 
-/// --- run: the filter, with the progress bar; the first Ctrl-C cancels it cleanly.
+/// --- run: the filter, with the progress bar; a Ctrl-C (handler installed by run()) cancels it
+/// cleanly at its next progress report.
 void runFilter(vtkSDFCageFilter* filter, ProgressBar* progress)
 {
   filter->AddObserver(vtkCommand::ProgressEvent, progress);
-  std::signal(SIGINT, onInterrupt);
   filter->Update();
-  std::signal(SIGINT, SIG_DFL);
+}
+
+/// An interruption before or between the steps: exit code 130, nothing written.
+int interrupted(const Options& o, RunReport& r, ProgressBar* progress)
+{
+  progress->finish();
+  printError("interrupted");
+  r.Status = "Cancelled";
+  r.ErrorMessage = "interrupted";
+  return finish(o, r, ExitInterrupted);
+}
+
+/// Every file the run will write can be written: checked before anything is read or computed.
+bool checkOutputs(const Options& o, RunReport& r)
+{
+  for (const std::string* path : { &o.Output, &o.Report, &o.Screenshot })
+  {
+    std::string error;
+    if (!path->empty() && !checkWritable(*path, error))
+    {
+      printError(error);
+      r.Status = "UnwritableOutput";
+      r.ErrorMessage = error;
+      return false;
+    }
+  }
+  return true;
 }
 
 /// --- results: the filter's status and every result of its table (by name), the mesh sizes.
@@ -816,13 +875,48 @@ int stopCode(const Options& o, RunReport& r, const std::vector<std::string>& fil
   return -1;
 }
 
+/// PLY and STL store coordinates as 32-bit floats. Rounding moves every point of the cage by at
+/// most the largest vertex move, so the verified clearance survives when that move is a small
+/// part of it (at most a tenth); far from the origin (1e12 away, say) it is not: then nothing
+/// is written and the message says which formats keep doubles.
+bool fitsSinglePrecision(vtkPolyData* cage, const std::string& path, double clearance, std::string& error)
+{
+  const std::string ext = lowerExtension(path);
+  if (ext != ".ply" && ext != ".stl")
+  {
+    return true;
+  }
+  double largest = 0.0;
+  for (vtkIdType i = 0; i < cage->GetNumberOfPoints(); ++i)
+  {
+    double p[3];
+    cage->GetPoint(i, p);
+    double moved = 0.0;
+    for (double c : p)
+    {
+      const double d = c - static_cast<double>(static_cast<float>(c));
+      moved += d * d;
+    }
+    largest = std::max(largest, std::sqrt(moved));
+  }
+  if (!(largest <= 0.1 * clearance))
+  {
+    error = "cannot write '" + path + "': single precision (" + ext + " stores 32-bit floats) would move the cage by up to " +
+      shortNumber(largest) + ", more than a tenth of its clearance " + shortNumber(clearance) +
+      " (input far from the origin?): write .vtp, .vtk, .off or .obj, which keep doubles";
+    return false;
+  }
+  return true;
+}
+
 /// --- write: the cage file. False (with the status in `r`) when it cannot be written.
 bool writeCage(vtkPolyData* cage, const Options& o, RunReport& r, ProgressBar* progress)
 {
   const Clock::time_point start = Clock::now();
   progress->step("writing " + std::filesystem::path(o.Output).filename().string(), 1.0);
   std::string error;
-  if (!writeMesh(cage, o.Output, error))
+  if (!fitsSinglePrecision(cage, o.Output, r.number("MeasuredClearance"), error) ||
+    !writeMesh(cage, o.Output, error))
   {
     progress->finish();
     printError(error);
@@ -882,10 +976,19 @@ int run(const Options& o, MessageCollector* messages)
       return finish(o, r, ExitFailure);
     }
   }
+  if (!checkOutputs(o, r))
+  {
+    // the report itself may be what cannot be written: finish() then says so too
+    return finish(o, r, ExitUnusable);
+  }
   vtkNew<ProgressBar> progress;
   progress->Enabled = !o.Quiet && isatty(STDERR_FILENO);
 
   vtkSmartPointer<vtkPolyData> input = readInput(o, r, progress, messages);
+  if (InterruptRequested)
+  {
+    return interrupted(o, r, progress);
+  }
   if (!input)
   {
     return finish(o, r, ExitUnusable);
@@ -893,6 +996,10 @@ int run(const Options& o, MessageCollector* messages)
   vtkNew<vtkSDFCageFilter> filter;
   filter->SetInputData(input);
   configureFilter(filter, o, r);
+  if (InterruptRequested)
+  {
+    return interrupted(o, r, progress);
+  }
   runFilter(filter, progress);
   collectResults(filter, r);
   const std::vector<std::string> filterErrors = takeFilterMessages(messages, o.Quiet, progress);
@@ -943,6 +1050,9 @@ int run(const Options& o, MessageCollector* messages)
 
 int main(int argc, char* argv[])
 {
+  // Ctrl-C from here on: the first one stops the run cleanly (checked while reading, at every
+  // progress report of the filter and between the steps; exit code 130), a second one kills.
+  std::signal(SIGINT, onInterrupt);
   try
   {
     MessageCollector* messages = MessageCollector::install();
