@@ -697,6 +697,48 @@ bool topologyDiffers(const EnvelopeResult& r)
   return r.State == Status::Ok && r.InputClosed && (r.Genus != r.InputGenus || r.Components != r.InputComponents);
 }
 
+/// Are the bounding boxes of the input's components pairwise disjoint? (Then fewer envelope
+/// parts than input parts means parts fused. Nested or overlapping parts share a box: their
+/// envelope has fewer parts whatever the resolution, and no repair can change that.)
+bool componentBoxesDisjoint(const TriangleMesh& m)
+{
+  std::vector<int> comp;
+  const int n = triangleComponents(m, comp);
+  if (n < 2 || n > 4096)
+  {
+    return n < 2;
+  }
+  const double inf = std::numeric_limits<double>::infinity();
+  std::vector<Vec3> lo(n, Vec3::Constant(inf)), hi(n, Vec3::Constant(-inf));
+  for (std::size_t t = 0; t < m.Triangles.size(); ++t)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      lo[comp[t]] = lo[comp[t]].cwiseMin(m.Points[m.Triangles[t][k]]);
+      hi[comp[t]] = hi[comp[t]].cwiseMax(m.Points[m.Triangles[t][k]]);
+    }
+  }
+  for (int i = 0; i < n; ++i)
+  {
+    for (int j = i + 1; j < n; ++j)
+    {
+      if ((lo[i].array() <= hi[j].array()).all() && (lo[j].array() <= hi[i].array()).all())
+      {
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+/// Can a repair help? When the envelope has more handles than the input (fused parts closing a
+/// loop), or fewer parts while the input's parts lie apart.
+bool repairMayHelp(const EnvelopeResult& r, const TriangleMesh& input)
+{
+  return topologyDiffers(r) &&
+    (r.Genus > r.InputGenus || (r.Components < r.InputComponents && componentBoxesDisjoint(input)));
+}
+
 /// Surface area of the input (unit-sphere units): the narrow-band grid holds about area / h^2
 /// voxels along it.
 double surfaceArea(const TriangleMesh& m)
@@ -740,7 +782,7 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
   EnvelopeResult first = buildEnvelopeOnce(unitInput, options, progress, progressEnd, inputClosed);
   const bool repairable = first.SignUsed == SignMode::FloodFill && options.UseActivePoints &&
     options.MaximumTopologyRepairs > 0 && !first.TooComplex;
-  if (!topologyDiffers(first) || !repairable)
+  if (!repairable || !repairMayHelp(first, unitInput))
   {
     if (topologyDiffers(first) && options.RequireTopology)
     {
