@@ -3,9 +3,9 @@
 # xvfb-run so tests that render find an X server (a test that fails is run once more: the X
 # server connection of the rendering tests has been seen to drop once in a while, a real failure
 # fails twice); tests needing ../shared/data skip when it is
-# absent. Then .ci/fuzz.sh fuzzes the readers and Core for a few minutes.
+# absent. Two tests run at a time (2 cores). Then .ci/fuzz.sh fuzzes the readers and Core for a few minutes.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-xvfb-run -a ctest --test-dir build --output-on-failure --repeat until-pass:2 "$@"
+xvfb-run -a ctest --test-dir build -j2 --output-on-failure --repeat until-pass:2 "$@"
 # then the fuzzers (libFuzzer + ASan/UBSan, a bounded time each; build-fuzz/)
 bash .ci/fuzz.sh
