@@ -6,6 +6,8 @@
 # absent. Two tests run at a time (2 cores). Then .ci/fuzz.sh fuzzes the readers and Core for a few minutes.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-xvfb-run -a ctest --test-dir build -j2 --output-on-failure --repeat until-pass:2 "$@"
+xvfb-run -a ctest --test-dir build -j2 -LE rendering --output-on-failure --repeat until-pass:2 "$@"
+# the tests that render, one at a time (two at once on one virtual X server lose the connection)
+xvfb-run -a ctest --test-dir build -L rendering --output-on-failure --repeat until-pass:2 "$@"
 # then the fuzzers (libFuzzer + ASan/UBSan, a bounded time each; build-fuzz/)
 bash .ci/fuzz.sh
