@@ -526,11 +526,26 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
   // verification (merged polygons can cut corners or cross), without it from the same field; then
   // finer grids without adaptivity.
   int attempt = 0;
+  // A coarse grid first (EnvelopeOptions::CoarseFirst): nothing below the isovalue needs
+  // resolving when no point is active, and a closed input's topology tells whether the coarse
+  // envelope fused anything. Level -1 is that grid; level 0 the requested one.
+  const bool coarseFirst = options.CoarseFirst && !(options.VoxelSize > 0) && flood &&
+    (!amplification || amplification->empty()) && result.InputClosed;
   const int levels = 1 + std::max(0, options.MaximumRefinements);
-  for (int level = 0; level < levels; ++level, h *= 0.5)
+  if (coarseFirst)
   {
+    h *= 2.0;
+  }
+  for (int level = coarseFirst ? -1 : 0; level < levels; ++level, h *= 0.5)
+  {
+    const bool coarseLevel = level < 0;
+    bool coarseRejected = false;
     // the memory budget, before the grid is built (MemoryBudget.h)
     const std::size_t need = estimateEnvelopeBytes(unitInput, h, c, flood, options.KeepDistanceField);
+    if (need > options.memoryLimit() && coarseLevel)
+    {
+      continue; // the requested grid, finer, is over it too: its check names the need
+    }
     if (need > options.memoryLimit())
     {
       std::ostringstream m;
@@ -547,7 +562,7 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
       break;
     }
     std::vector<double> adaptivities{ 0.0 };
-    if (level == 0 && options.Adaptivity > 0)
+    if (level <= 0 && options.Adaptivity > 0)
     {
       adaptivities = { options.Adaptivity, 0.0 };
     }
@@ -565,6 +580,11 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
         std::vector<int> comp;
         const int parts = triangleComponents(envelope, comp);
         const int g = checkTriangleMesh(envelope).usable() ? genus(envelope) : 0;
+        if (minimumCageVertices(parts, g) > options.VertexBudget && coarseLevel)
+        {
+          coarseRejected = true; // the requested grid may separate what the coarse one fused
+          return true;           // stops the extraction
+        }
         if (minimumCageVertices(parts, g) > options.VertexBudget)
         {
           result.TooComplex = true;
@@ -596,7 +616,7 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
         result.RemovedPockets = pockets;
         result.VoxelSizeUsed = h;
         result.AdaptivityUsed = adaptivity;
-        result.Refinements = level;
+        result.Refinements = std::max(0, level);
         accepted = true;
       }
       else if (!progressCancelled(progress))
@@ -636,6 +656,22 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
       result.State = Status::Failed;
       result.Message = iso.Error;
       return result;
+    }
+    if (coarseRejected)
+    {
+      continue;
+    }
+    if (accepted && coarseLevel)
+    {
+      std::vector<int> comp;
+      if (triangleComponents(result.Envelope, comp) != result.InputComponents ||
+        genus(result.Envelope) != result.InputGenus)
+      {
+        accepted = false; // fused on the coarse grid: the requested grid decides
+        result.Envelope = TriangleMesh();
+        result.DistanceToInput.clear();
+        continue;
+      }
     }
     result.DistanceField = std::move(iso.Field);
     result.ModifiedDistanceField = std::move(iso.ModifiedField);

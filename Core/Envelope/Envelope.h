@@ -60,6 +60,13 @@ struct EnvelopeOptions
   double Adaptivity = 0.3;
   /// If verification fails, retry up to this many times with half the voxel size.
   int MaximumRefinements = 2;
+  /// Coarse grid first: with the automatic voxel size, a closed input (flood-fill sign) without
+  /// active points is first tried on a grid twice as coarse (voxel = IsoValue: about 8x fewer
+  /// voxels in the narrow band and 4x fewer isosurface cells). Its envelope is kept only when it
+  /// is verified like any other and has the input's genus and parts; otherwise the requested
+  /// grid (IsoValue / 2) follows as if the coarse one had not been tried. Refinements counts the
+  /// grids finer than the requested one only.
+  bool CoarseFirst = true;
   /// Measure the envelope's exact minimum clearance (costly on a dense envelope) instead of
   /// certifying that it is at least the clearance (a certified lower bound is reported then).
   bool ExactEnvelopeClearance = false;

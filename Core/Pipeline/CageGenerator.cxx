@@ -246,6 +246,23 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
 {
   const auto start = std::chrono::steady_clock::now();
   CageResult best = generateOnce(input, options, progress, options.MaximumEnvelopeWidenings > 0);
+  // A cage simplified from the coarse grid's envelope (EnvelopeOptions::CoarseFirst) that misses
+  // its target (small targets: the coarse envelope's merged polygons leave the simplifier fewer
+  // placements) is made again from the requested grid's envelope; the one with fewer vertices
+  // is kept.
+  if (best.State == Status::Ok && !best.TargetReached && options.TargetNumberOfVertices > 0 &&
+    options.Envelope.CoarseFirst && best.VoxelSizeUsed > options.Envelope.voxelSize() * (1.0 + 1e-9) &&
+    !progressCancelled(progress))
+  {
+    CageOptions requested = options;
+    requested.Envelope.CoarseFirst = false;
+    progressStage(progress, "the envelope on the requested grid, to reach the target", 0.0, 1.0);
+    CageResult next = generateOnce(input, requested, progress, options.MaximumEnvelopeWidenings > 0);
+    if (next.State == Status::Cancelled || (next.State == Status::Ok && next.VerticesReached < best.VerticesReached))
+    {
+      best = std::move(next);
+    }
+  }
   CageOptions wider = options;
   int tried = 0;
   std::string log;

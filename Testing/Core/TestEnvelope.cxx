@@ -156,7 +156,8 @@ TEST_P(EnvelopeShapes, GenerateCageEnclosesExactly)
   {
     EXPECT_FALSE(result.StopReason.empty());
   }
-  EXPECT_LE(result.VoxelSizeUsed, options.Envelope.voxelSize() * (1 + 1e-12));
+  // the coarse grid (EnvelopeOptions::CoarseFirst) is twice the automatic voxel size
+  EXPECT_LE(result.VoxelSizeUsed, 2.0 * options.Envelope.voxelSize() * (1 + 1e-12));
   EXPECT_GT(result.VoxelSizeUsed, 0.0);
 
   // Per-point distances: one per point, never below the exact triangle clearance, and equal to a
@@ -237,7 +238,7 @@ TEST_P(EnvelopeShapes, BuildEnvelopeEnclosesExactly)
   EXPECT_LE(env.MinimumClearance, r.MinimumClearance * (1.0 + 1e-9));
   EXPECT_EQ(env.Genus, r.CageGenus);
   EXPECT_EQ(env.Components, r.CageComponents);
-  EXPECT_LE(env.VoxelSizeUsed, options.voxelSize() * (1 + 1e-12));
+  EXPECT_LE(env.VoxelSizeUsed, 2.0 * options.voxelSize() * (1 + 1e-12));
   EXPECT_EQ(env.DistanceToInput.size(), env.Envelope.Points.size());
 
   // The kept field is a dense grid covering the envelope.
@@ -254,6 +255,51 @@ TEST_P(EnvelopeShapes, BuildEnvelopeEnclosesExactly)
 }
 
 INSTANTIATE_TEST_SUITE_P(Shapes, EnvelopeShapes, ::testing::ValuesIn(shapeCases()), caseName);
+
+// The coarse grid first (EnvelopeOptions::CoarseFirst): used where nothing needs the finer grid,
+// and never losing a handle the requested grid keeps. Tori whose hole is a little wider than the
+// active radius or without active points, their axis between the coarse grid's samples and on a
+// sample of the requested grid: the narrowest close on the coarse grid and stay open on the other.
+TEST(CoarseFirst, KeepsWhatTheRequestedGridKeeps)
+{
+  EnvelopeOptions coarse, fine;
+  fine.CoarseFirst = false;
+  ASSERT_TRUE(coarse.CoarseFirst) << "the default";
+  const TriangleMesh sphere = makeSphere(Vec3(0, 0, 0), 1.0, 64, 32);
+  const EnvelopeResult s = buildEnvelope(sphere, coarse);
+  ASSERT_EQ(s.State, Status::Ok) << s.Message;
+  EXPECT_DOUBLE_EQ(s.VoxelSizeUsed, coarse.IsoValue) << "a sphere needs no finer grid";
+  EXPECT_EQ(s.Refinements, 0);
+  expectEncloses(sphere, s.Envelope, coarse.clearance(), 2.0 * coarse.IsoValue, "sphere, coarse grid");
+  const EnvelopeResult sf = buildEnvelope(sphere, fine);
+  ASSERT_EQ(sf.State, Status::Ok) << sf.Message;
+  EXPECT_DOUBLE_EQ(sf.VoxelSizeUsed, fine.voxelSize());
+  EXPECT_LT(s.Envelope.Triangles.size(), sf.Envelope.Triangles.size());
+
+  int fellBack = 0;
+  coarse.UseActivePoints = fine.UseActivePoints = false;
+  for (double hole : { 0.026, 0.04 })
+  {
+    // in the unit sphere: R + r = 1, hole diameter 2 (R - r)
+    const double R = 0.5 * (1.0 + 0.5 * hole), r = 0.5 * (1.0 - 0.5 * hole);
+    const TriangleMesh torus = makeTorus(Vec3(0.005, 0.005, 0.0), R, r, 160, 96);
+    const std::string name = "torus, hole " + std::to_string(hole);
+    const EnvelopeResult a = buildEnvelope(torus, coarse);
+    const EnvelopeResult b = buildEnvelope(torus, fine);
+    ASSERT_EQ(a.State, Status::Ok) << name << ": " << a.Message;
+    ASSERT_EQ(b.State, Status::Ok) << name << ": " << b.Message;
+    std::cout << "[ coarse   ] " << name << ": " << a.NumberOfActivePoints << " active points; coarse first: voxel "
+              << a.VoxelSizeUsed << ", genus " << a.Genus << "; requested grid: voxel " << b.VoxelSizeUsed << ", genus "
+              << b.Genus << "\n";
+    if (b.Genus == 1)
+    {
+      EXPECT_EQ(a.Genus, 1) << name << ": the coarse grid lost the handle the requested grid keeps";
+    }
+    fellBack += a.VoxelSizeUsed < coarse.IsoValue ? 1 : 0;
+    expectEncloses(torus, a.Envelope, coarse.clearance(), 2.0 * coarse.IsoValue, name + ", coarse first");
+  }
+  EXPECT_GE(fellBack, 1) << "no torus exercised the fallback from the coarse grid";
+}
 
 TEST(Envelope, LargerIsoValueExplicitAndExactClearance)
 {
