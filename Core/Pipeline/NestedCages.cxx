@@ -157,6 +157,12 @@ NestedCageResult generateNestedCages(
       // the paper's procedure: the whole method again, on the cage of the level inside
       levelOptions.Envelope.Sign = SignMode::Auto; // a cage is closed and oriented: flood fill
       levelOptions.Envelope.KeepDistanceField = false;
+      // Active points only where the input has nearly touching parts (level 0 found some): a
+      // coarse cage has no such parts of its own, but its long edges fool the geodesic test
+      // (measured: 5 spurious active points on a 60-vertex cage of a cube, whose envelope then
+      // grew from 7k to 115k points and stalled the simplification at 1105 of 20 vertices).
+      levelOptions.Envelope.UseActivePoints =
+        options.Envelope.UseActivePoints && nested.Levels[0].Result.NumberOfActivePoints > 0;
       level.Result = generateCage(PolygonMesh::fromTriangles(nested.Levels[k - 1].Result.Cage), levelOptions, &levelProgress);
     }
     const CageResult& r = level.Result;

@@ -62,7 +62,8 @@ std::string parseNestedCounts(const std::string& text, std::vector<int>& counts)
 /// the input is at least as far from the input as from that surface). Each level is then
 /// re-verified in the input's coordinates against the level inside it and against the input.
 /// Levels k >= 1 use options as given, except: their inside is decided by flood fill (a cage is
-/// a closed 2-manifold), and no distance field is kept. Progress is split evenly over the levels.
+/// a closed 2-manifold), no distance field is kept, and active points are used only when level 0
+/// found some (the input has nearly touching parts that the cages must keep apart). Progress is split evenly over the levels.
 NestedCageResult generateNestedCages(
   const PolygonMesh& input, std::vector<int> counts, const CageOptions& options, Progress* progress = nullptr);
 
