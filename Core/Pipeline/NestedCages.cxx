@@ -163,7 +163,8 @@ NestedCageResult generateNestedCages(
       // grew from 7k to 115k points and stalled the simplification at 1105 of 20 vertices).
       levelOptions.Envelope.UseActivePoints =
         options.Envelope.UseActivePoints && nested.Levels[0].Result.NumberOfActivePoints > 0;
-      level.Result = generateCage(PolygonMesh::fromTriangles(nested.Levels[k - 1].Result.Cage), levelOptions, &levelProgress);
+      level.Result =
+        generateCage(PolygonMesh::fromTriangles(nested.Levels[k - 1].Result.Cage), levelOptions, &levelProgress);
     }
     const CageResult& r = level.Result;
     if (r.State != Status::Ok)
@@ -173,11 +174,11 @@ NestedCageResult generateNestedCages(
       std::ostringstream msg;
       msg << "level " << (k + 1) << " (" << counts[k] << " vertices)" << (k > 0 ? ", built on the level inside it" : "")
           << ": " << (r.Message.empty() ? std::string("no reason given") : r.Message);
-      nested.Message = r.State == Status::Cancelled ? "cancelled; " + std::to_string(k) + " level(s) finished"
-                                                    : msg.str();
+      nested.Message =
+        r.State == Status::Cancelled ? "cancelled; " + std::to_string(k) + " level(s) finished" : msg.str();
       if (k == 0 && r.State != Status::Cancelled)
       {
-        nested.Message = r.Message; // the input's own error, as a single run gives it
+        nested.Message = r.Message;                // the input's own error, as a single run gives it
         nested.Levels.push_back(std::move(level)); // its defects and envelope, for the caller to report
       }
       nested.TotalSeconds = seconds(start);
@@ -210,12 +211,12 @@ NestedCageResult generateNestedCages(
       level.VerifiedAgainstInput =
         verifyEnclosure(inputMesh, r.Cage, inputClearance, level.ClearanceToInput, why, nullptr, &levelProgress);
       if (!why.empty())
-        level.VerificationMessage += (level.VerificationMessage.empty() ? "" : "; ") + std::string("against the input: ") + why;
+        level.VerificationMessage +=
+          (level.VerificationMessage.empty() ? "" : "; ") + std::string("against the input: ") + why;
     }
     level.CageGenus = genus(r.Cage);
     level.CageComponents = componentsOf(r.Cage);
-    level.TopologyKept =
-      inputClosed && level.CageGenus == inputGenus && level.CageComponents == inputComponents;
+    level.TopologyKept = inputClosed && level.CageGenus == inputGenus && level.CageComponents == inputComponents;
     level.Seconds = seconds(t0);
     const bool verified = level.VerifiedAgainstInside && level.VerifiedAgainstInput;
     const bool cancelled = progressCancelled(progress);

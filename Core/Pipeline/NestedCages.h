@@ -26,7 +26,7 @@ struct NestedLevel
   bool VerifiedAgainstInside = false;
   double ClearanceToInside = 0.0; ///< measured exact minimum distance, input units
   bool VerifiedAgainstInput = false;
-  double ClearanceToInput = 0.0; ///< measured exact minimum distance, input units
+  double ClearanceToInput = 0.0;   ///< measured exact minimum distance, input units
   std::string VerificationMessage; ///< why a re-verification failed (empty when both passed)
   int CageGenus = 0;               ///< of this cage (sum over its parts)
   int CageComponents = 0;
