@@ -6,7 +6,6 @@
 #include <functional>
 #include <string>
 
-class vtkMultiBlockDataSet;
 class vtkPolyData;
 
 namespace sdfcage_cli
@@ -36,15 +35,6 @@ bool checkWritable(const std::string& path, std::string& error);
 
 /// Writes `mesh` in the format of the extension of `path`. Returns false with a reason.
 bool writeMesh(vtkPolyData* mesh, const std::string& path, std::string& error);
-
-/// True for the extensions of multi-block files (".vtm", ".vtpc"): nested cages in one file.
-bool isMultiBlockExtension(const std::string& path);
-
-/// Writes the nested levels (blocks of vtkPolyData, named) as one file: .vtm (VTK's XML
-/// multi-block: the .vtm plus a folder of that name with one .vtp per block) or .vtpc (a
-/// vtkPartitionedDataSetCollection, one partition per level, the same names; also a folder).
-/// Returns false with a reason.
-bool writeMultiBlock(vtkMultiBlockDataSet* levels, const std::string& path, std::string& error);
 
 /// sdfcage::makeBuiltinShape() as vtkPolyData (points and triangles).
 vtkSmartPointer<vtkPolyData> builtinShape();

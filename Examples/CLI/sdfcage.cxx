@@ -13,6 +13,7 @@
 #include "CLICheck.h"
 #include "CLIMeshIO.h"
 #include "CLIMessages.h"
+#include "CLIMultiBlock.h"
 #include "CLIReport.h"
 #include "CLIScreenshot.h"
 
