@@ -133,3 +133,23 @@ TEST(NestedCages, CancelKeepsTheFinishedLevels)
   EXPECT_EQ(r.Levels[0].Result.VerticesReached, 300);
   EXPECT_TRUE(r.Levels[0].VerifiedAgainstInput);
 }
+
+// The level's results share a block's field data with the level's run (cageResults): the names
+// must not clash, and each is a described CamelCase identifier.
+TEST(NestedCages, LevelResultsAreDescribedAndApartFromTheRunResults)
+{
+  const ResultTable level = nestedLevelResults(NestedLevel(), 0);
+  const ResultTable run = cageResults(CageResult());
+  ASSERT_FALSE(level.empty());
+  for (const ResultField& f : level)
+  {
+    EXPECT_FALSE(f.Name.empty());
+    EXPECT_FALSE(f.Description.empty()) << f.Name;
+    EXPECT_EQ(findResult(run, f.Name), nullptr) << f.Name << " is also a result of the run";
+    EXPECT_EQ(&*findResult(level, f.Name), &f) << f.Name << " is used twice";
+    if (f.Type == ResultField::Kind::Flag)
+    {
+      EXPECT_TRUE(f.Unit.empty()) << f.Name;
+    }
+  }
+}
