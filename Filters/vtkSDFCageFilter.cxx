@@ -8,6 +8,7 @@
 
 #include "vtkCellArray.h"
 #include "vtkCellArrayIterator.h"
+#include "vtkCompositeDataSet.h"
 #include "vtkDataObject.h"
 #include "vtkDoubleArray.h"
 #include "vtkFieldData.h"
@@ -17,6 +18,7 @@
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkIntArray.h"
+#include "vtkMultiBlockDataSet.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
@@ -26,6 +28,7 @@
 #include "vtkStringArray.h"
 
 #include "Pipeline/CageGenerator.h"
+#include "Pipeline/NestedCages.h"
 #include "Pipeline/Results.h"
 #include "SDFCageParallel.h"
 #include "SDFCageVTKConversion.h"
@@ -80,12 +83,60 @@ vtkSDFCageFilter::vtkSDFCageFilter()
 
   this->Internals = std::make_unique<vtkInternals>();
   this->SetNumberOfInputPorts(1);
-  this->SetNumberOfOutputPorts(3);
+  this->SetNumberOfOutputPorts(4);
   this->ResetResults();
 }
 
 //------------------------------------------------------------------------------
 vtkSDFCageFilter::~vtkSDFCageFilter() = default;
+
+//------------------------------------------------------------------------------
+void vtkSDFCageFilter::SetNumberOfNestedLevels(int number)
+{
+  const std::size_t n = static_cast<std::size_t>(std::max(0, number));
+  if (n != this->NestedVertexCounts.size())
+  {
+    this->NestedVertexCounts.resize(n, 0);
+    this->Modified();
+  }
+}
+
+//------------------------------------------------------------------------------
+int vtkSDFCageFilter::GetNumberOfNestedLevels() const
+{
+  return static_cast<int>(this->NestedVertexCounts.size());
+}
+
+//------------------------------------------------------------------------------
+// Like vtkContourFilter::SetValue: an index past the end grows the list (new entries 0, which
+// the execution rejects until they are set).
+void vtkSDFCageFilter::SetNestedVertexCount(int level, int count)
+{
+  if (level < 0)
+  {
+    vtkErrorMacro("SetNestedVertexCount: the level index must be >= 0, got " << level);
+    return;
+  }
+  const std::size_t i = static_cast<std::size_t>(level);
+  if (i >= this->NestedVertexCounts.size())
+  {
+    this->NestedVertexCounts.resize(i + 1, 0);
+  }
+  else if (this->NestedVertexCounts[i] == count)
+  {
+    return;
+  }
+  this->NestedVertexCounts[i] = count;
+  this->Modified();
+}
+
+//------------------------------------------------------------------------------
+int vtkSDFCageFilter::GetNestedVertexCount(int level) const
+{
+  return level >= 0 && static_cast<std::size_t>(level) < this->NestedVertexCounts.size()
+    ? this->NestedVertexCounts[static_cast<std::size_t>(level)]
+    : 0;
+}
 
 //------------------------------------------------------------------------------
 void vtkSDFCageFilter::ResetResults()
@@ -102,6 +153,11 @@ int vtkSDFCageFilter::FillOutputPortInformation(int port, vtkInformation* info)
   if (port == 2)
   {
     info->Set(vtkDataObject::DATA_TYPE_NAME(), "vtkImageData");
+    return 1;
+  }
+  if (port == 3)
+  {
+    info->Set(vtkDataObject::DATA_TYPE_NAME(), "vtkMultiBlockDataSet");
     return 1;
   }
   return this->Superclass::FillOutputPortInformation(port, info);
@@ -167,7 +223,11 @@ int vtkSDFCageFilter::RequestData(
   return RunOnWholeSurface(
     this, inputVector, outputVector, run,
     [this, outputVector](const std::vector<vtkPolyData*>& inputs) { return this->Execute(inputs[0], outputVector); },
-    [this](vtkFieldData* fd) { this->AdoptResults(fd); });
+    [this, outputVector](vtkFieldData* fd) {
+      this->AdoptResults(fd);
+      // the same block structure as process 0's, every block empty
+      this->MakeEmptyLevels(vtkMultiBlockDataSet::GetData(outputVector, 3));
+    });
 }
 
 //------------------------------------------------------------------------------
@@ -188,7 +248,8 @@ int vtkSDFCageFilter::Execute(vtkPolyData* input, vtkInformationVector* outputVe
   vtkPolyData* cageOutput = vtkPolyData::GetData(outputVector, 0);
   vtkPolyData* envelopeOutput = vtkPolyData::GetData(outputVector, 1);
   vtkImageData* fieldOutput = vtkImageData::GetData(outputVector, 2);
-  if (!cageOutput || !envelopeOutput || !fieldOutput)
+  vtkMultiBlockDataSet* levelsOutput = vtkMultiBlockDataSet::GetData(outputVector, 3);
+  if (!cageOutput || !envelopeOutput || !fieldOutput || !levelsOutput)
   {
     vtkErrorMacro("Output data objects are missing or of the wrong type.");
     return 0;
@@ -196,6 +257,22 @@ int vtkSDFCageFilter::Execute(vtkPolyData* input, vtkInformationVector* outputVe
   cageOutput->Initialize();
   envelopeOutput->Initialize();
   fieldOutput->Initialize();
+  levelsOutput->Initialize();
+  if (!this->NestedVertexCounts.empty())
+  {
+    std::vector<int> counts = this->NestedVertexCounts;
+    const std::string bad = sdfcage::sortNestedCounts(counts);
+    if (!bad.empty())
+    {
+      std::ostringstream msg;
+      msg << "NestedVertexCounts (";
+      for (std::size_t i = 0; i < this->NestedVertexCounts.size(); ++i)
+        msg << (i ? "," : "") << this->NestedVertexCounts[i];
+      msg << "): " << bad << ".";
+      return this->Fail(StatusIdentifier(sdfcage::Status::InvalidInput), msg.str(), cageOutput);
+    }
+    this->MakeEmptyLevels(levelsOutput);
+  }
 
   if (!input || input->GetNumberOfPoints() == 0 || input->GetNumberOfCells() == 0 ||
     input->GetNumberOfPolys() + input->GetNumberOfStrips() == 0)
@@ -207,6 +284,10 @@ int vtkSDFCageFilter::Execute(vtkPolyData* input, vtkInformationVector* outputVe
     // read -> options -> run -> results -> outputs
     sdfcage::PolygonMesh mesh;
     ToPolygonMesh(input, mesh);
+    if (!this->NestedVertexCounts.empty())
+    {
+      return this->ExecuteNested(mesh, cageOutput, envelopeOutput, fieldOutput, levelsOutput);
+    }
     const sdfcage::CageOptions options = CageOptionsOf(this);
     FilterProgress progress(this);
     this->UpdateProgress(0.0);
@@ -220,6 +301,7 @@ int vtkSDFCageFilter::Execute(vtkPolyData* input, vtkInformationVector* outputVe
   {
     envelopeOutput->Initialize();
     fieldOutput->Initialize();
+    this->MakeEmptyLevels(levelsOutput);
     return this->Fail(StatusIdentifier(sdfcage::Status::Failed),
       "Out of memory. Use a larger VoxelSize (or IsoValue), or turn GenerateDistanceField off.", cageOutput);
   }
@@ -227,6 +309,7 @@ int vtkSDFCageFilter::Execute(vtkPolyData* input, vtkInformationVector* outputVe
   {
     envelopeOutput->Initialize();
     fieldOutput->Initialize();
+    this->MakeEmptyLevels(levelsOutput);
     return this->Fail(
       StatusIdentifier(sdfcage::Status::Failed), std::string("Cage generation failed: ") + e.what(), cageOutput);
   }
@@ -234,9 +317,116 @@ int vtkSDFCageFilter::Execute(vtkPolyData* input, vtkInformationVector* outputVe
   {
     envelopeOutput->Initialize();
     fieldOutput->Initialize();
+    this->MakeEmptyLevels(levelsOutput);
     return this->Fail(
       StatusIdentifier(sdfcage::Status::Failed), "Cage generation failed with an unknown exception.", cageOutput);
   }
+}
+
+//------------------------------------------------------------------------------
+// One empty block per nested level (sorted finest first), named like the level, Status
+// "NotBuilt": the structure of port 3 depends on the parameters only, so every process of an MPI
+// run and every outcome has the same blocks.
+void vtkSDFCageFilter::MakeEmptyLevels(vtkMultiBlockDataSet* levels) const
+{
+  if (!levels)
+  {
+    return;
+  }
+  levels->Initialize();
+  std::vector<int> counts = this->NestedVertexCounts;
+  if (counts.empty() || !sdfcage::sortNestedCounts(counts).empty())
+  {
+    return;
+  }
+  levels->SetNumberOfBlocks(static_cast<unsigned int>(counts.size()));
+  for (std::size_t k = 0; k < counts.size(); ++k)
+  {
+    vtkNew<vtkPolyData> block;
+    AddFieldValue<vtkStringArray>(block->GetFieldData(), "Status", std::string("NotBuilt"));
+    const unsigned int b = static_cast<unsigned int>(k);
+    levels->SetBlock(b, block);
+    levels->GetMetaData(b)->Set(vtkCompositeDataSet::NAME(), ("cage_" + std::to_string(counts[k])).c_str());
+  }
+}
+
+//------------------------------------------------------------------------------
+// Nested cages: the levels on port 3, the finest level's run on ports 0-2 and in the getters.
+int vtkSDFCageFilter::ExecuteNested(const sdfcage::PolygonMesh& mesh, vtkPolyData* cage, vtkPolyData* envelope,
+  vtkImageData* field, vtkMultiBlockDataSet* levels)
+{
+  const sdfcage::CageOptions options = CageOptionsOf(this);
+  FilterProgress progress(this);
+  this->UpdateProgress(0.0);
+  const sdfcage::NestedCageResult nested =
+    sdfcage::generateNestedCages(mesh, this->NestedVertexCounts, options, &progress);
+  if (!nested.Levels.empty())
+  {
+    this->Internals->Results = sdfcage::cageResults(nested.Levels[0].Result);
+  }
+  this->StatusString = StatusIdentifier(nested.State);
+  this->LastErrorMessage = nested.Message;
+
+  // the levels that were built, each with its results
+  for (std::size_t k = 0; k < nested.Levels.size(); ++k)
+  {
+    const sdfcage::NestedLevel& level = nested.Levels[k];
+    if (level.Result.Cage.empty())
+    {
+      continue; // level 0's failure: its block stays "NotBuilt"
+    }
+    vtkPolyData* block = vtkPolyData::SafeDownCast(levels->GetBlock(static_cast<unsigned int>(k)));
+    ToPolyData(level.Result.Cage, level.Result.CageDistanceToInput, block);
+    vtkFieldData* fd = block->GetFieldData();
+    fd->Initialize();
+    AddResultArrays(fd, sdfcage::cageResults(level.Result));
+    AddResultArrays(fd, sdfcage::nestedLevelResults(level, static_cast<int>(k)));
+    AddFieldValue<vtkStringArray>(fd, "Status", StatusIdentifier(level.Result.State));
+    std::ostringstream prefix;
+    prefix << "nested level " << k << " (" << level.TargetNumberOfVertices << " vertices): ";
+    this->WarnAbout(level.Result, level.TargetNumberOfVertices, prefix.str());
+  }
+
+  const bool finestBuilt = !nested.Levels.empty() && !nested.Levels[0].Result.Cage.empty();
+  if (finestBuilt)
+  {
+    const sdfcage::CageResult& r0 = nested.Levels[0].Result;
+    ToPolyData(r0.Cage, r0.CageDistanceToInput, cage);
+    ToPolyData(r0.Envelope, r0.EnvelopeDistanceToInput, envelope);
+    if (this->GenerateDistanceField)
+    {
+      ToImageData(r0.DistanceField, field, "SignedDistance");
+      ToImageData(r0.ModifiedDistanceField, field, "ModifiedSignedDistance");
+    }
+  }
+  switch (nested.State)
+  {
+    case sdfcage::Status::Ok:
+      this->PublishResults(cage);
+      this->UpdateProgress(1.0);
+      return 1;
+    case sdfcage::Status::EmptyInput:
+    case sdfcage::Status::Cancelled:
+      // not errors; a cancel keeps the finished levels (each verified)
+      this->PublishResults(cage);
+      return 1;
+    default:
+      break;
+  }
+  if (!finestBuilt)
+  {
+    // the input itself could not be caged: exactly what a single run reports
+    if (!nested.Levels.empty() && nested.Levels[0].Result.State == sdfcage::Status::VerificationFailed)
+    {
+      const sdfcage::CageResult& r0 = nested.Levels[0].Result;
+      ToPolyData(r0.Envelope, r0.EnvelopeDistanceToInput, envelope);
+    }
+    return this->Fail(this->StatusString, "Cage generation failed: " + OrNoReason(nested.Message), cage);
+  }
+  // a coarser level failed: the finer ones are kept on the outputs, and the error says which
+  vtkErrorMacro(<< "Nested cages: " << OrNoReason(nested.Message));
+  this->PublishResults(cage);
+  return 0;
 }
 
 //------------------------------------------------------------------------------
@@ -305,7 +495,7 @@ int vtkSDFCageFilter::DeliverOutputs(
       return this->Fail(this->StatusString, "Cage generation failed: " + OrNoReason(result.Message), cage);
   }
 
-  this->WarnAbout(result);
+  this->WarnAbout(result, this->TargetNumberOfVertices);
   ToPolyData(result.Cage, result.CageDistanceToInput, cage);
   ToPolyData(result.Envelope, result.EnvelopeDistanceToInput, envelope);
   if (this->GenerateDistanceField)
@@ -321,7 +511,7 @@ int vtkSDFCageFilter::DeliverOutputs(
 //------------------------------------------------------------------------------
 // One warning for everything a successful run should tell: repairs of the input, an optimization
 // that did not happen, a target not reached, fused parts.
-void vtkSDFCageFilter::WarnAbout(const sdfcage::CageResult& result)
+void vtkSDFCageFilter::WarnAbout(const sdfcage::CageResult& result, int target, const std::string& prefix)
 {
   std::vector<std::string> warnings = result.Defects.warnings();
   if (this->Optimize && !result.Optimized && result.State == sdfcage::Status::Ok)
@@ -331,7 +521,7 @@ void vtkSDFCageFilter::WarnAbout(const sdfcage::CageResult& result)
   if (!result.TargetReached)
   {
     std::ostringstream msg;
-    msg << "the cage has " << result.VerticesReached << " vertices, not the " << this->TargetNumberOfVertices
+    msg << "the cage has " << result.VerticesReached << " vertices, not the " << target
         << " asked for: " << OrNoReason(result.StopReason);
     warnings.push_back(msg.str());
   }
@@ -342,6 +532,7 @@ void vtkSDFCageFilter::WarnAbout(const sdfcage::CageResult& result)
   if (!warnings.empty())
   {
     std::ostringstream msg;
+    msg << prefix;
     for (std::size_t i = 0; i < warnings.size(); ++i)
     {
       msg << (i ? "; " : "") << warnings[i];
@@ -366,6 +557,12 @@ void vtkSDFCageFilter::PrintSelf(ostream& os, vtkIndent indent)
 {
   this->Superclass::PrintSelf(os, indent);
   os << indent << "TargetNumberOfVertices: " << this->TargetNumberOfVertices << "\n";
+  os << indent << "NestedVertexCounts:";
+  for (int n : this->NestedVertexCounts)
+  {
+    os << " " << n;
+  }
+  os << (this->NestedVertexCounts.empty() ? " (none)\n" : "\n");
   os << indent << "IsoValue: " << this->IsoValue << "\n";
   os << indent << "VoxelSize: " << this->VoxelSize << "\n";
   os << indent << "MinimumClearance: " << this->MinimumClearance << "\n";

@@ -42,6 +42,8 @@
  *   is on, an empty image otherwise. The field is exact only in a narrow band around the input
  *   (a few voxels, enough to contain the envelope); farther away the values keep their sign but
  *   saturate at the band's width.
+ * - port 3 ("Nested Cages"): a vtkMultiBlockDataSet with one block per nested level when
+ *   NestedVertexCounts are set (see SetNumberOfNestedLevels), empty otherwise.
  *
  * Every length parameter is relative: it is measured in units of the input scaled into the unit
  * sphere (the paper's convention, §4). Every output is in the input's own coordinates and units.
@@ -86,14 +88,17 @@
 
 #include <memory> // For the results table
 #include <string> // For the status strings
+#include <vector> // For the nested vertex counts
 
 namespace sdfcage
 {
 struct CageResult;
+struct PolygonMesh;
 }
 
 class vtkFieldData;
 class vtkImageData;
+class vtkMultiBlockDataSet;
 
 class SDFCAGEFILTERS_EXPORT vtkSDFCageFilter : public vtkPolyDataAlgorithm
 {
@@ -109,6 +114,39 @@ public:
    */
   vtkSetClampMacro(TargetNumberOfVertices, int, 0, VTK_INT_MAX);
   vtkGetMacro(TargetNumberOfVertices, int);
+  ///@}
+
+  ///@{
+  /**
+   * Nested cages (paper §4, Fig. 9): a list of vertex counts, one cage per count, each strictly
+   * enclosing the next finer one (and so the input) with the clearance. Empty (the default): one
+   * cage of TargetNumberOfVertices, as before. Set like vtkContourFilter's values:
+   * SetNumberOfNestedLevels(3), SetNestedVertexCount(0, 2000), (1, 500), (2, 100); the order does
+   * not matter (the levels are sorted finest first); a count below 1 or given twice is an error
+   * (status InvalidInput, every output empty). TargetNumberOfVertices is then not used.
+   *
+   * The finest level is the usual run on the input; each coarser one reruns the whole method on
+   * the cage of the level inside it (the paper's procedure), and is re-verified in the input's
+   * coordinates against that level and against the input (sdfcage::generateNestedCages). Ports
+   * 0-2 then hold the finest level's cage, envelope and field, and the getters its results.
+   * Port 3 holds every level, finest first, as blocks named "cage_<count>" (vtkCompositeDataSet
+   * NAME()), each with the point array `DistanceToInput` (distance to the level inside it) and
+   * field data: that level's results (the same names as port 0's), Level, VerifiedAgainstInside,
+   * ClearanceToInside, VerifiedAgainstInput, ClearanceToInput, CageGenus, CageComponents,
+   * TopologyKept, LevelTime, and the string Status. A level that was not built (an error or a
+   * cancel stopped the run earlier) is an empty block with Status "NotBuilt".
+   *
+   * Why a fourth output port and not a separate filter: every parameter of a nested run is this
+   * filter's, ports 0-2 stay what existing pipelines and state files expect (a vtkPolyData cage
+   * on port 0), and ParaView shows named output ports as separate pipeline items, as it already
+   * does for the envelope and the field. Every gap between parts of the input narrows by at
+   * least twice the clearance per level, so parts that nearly touch fuse at some level: the
+   * level's TopologyWarning and TopologyKept say so.
+   */
+  void SetNumberOfNestedLevels(int number);
+  int GetNumberOfNestedLevels() const;
+  void SetNestedVertexCount(int level, int count);
+  int GetNestedVertexCount(int level) const; ///< 0 out of range
   ///@}
 
   ///@{
@@ -430,6 +468,7 @@ protected:
   int NumberOfIterations;
   vtkTypeBool EdgeFlips;
   int SignMode = 0;
+  std::vector<int> NestedVertexCounts;
 
   // outcome of the last execution (the results are in Internals' table)
   std::string StatusString;
@@ -441,12 +480,15 @@ private:
 
   // the phases of RequestData (Execute: on the whole input, see SDFCageParallel.h)
   int Execute(vtkPolyData* input, vtkInformationVector* outputVector);
+  int ExecuteNested(const sdfcage::PolygonMesh& mesh, vtkPolyData* cage, vtkPolyData* envelope, vtkImageData* field,
+    vtkMultiBlockDataSet* levels);
+  void MakeEmptyLevels(vtkMultiBlockDataSet* levels) const;
   void AdoptResults(vtkFieldData* fd);
   void ResetResults();
   int RejectInput(vtkPolyData* input, vtkPolyData* cage);
   int Fail(const std::string& status, const std::string& message, vtkPolyData* cage);
   int DeliverOutputs(const sdfcage::CageResult& result, vtkPolyData* cage, vtkPolyData* envelope, vtkImageData* field);
-  void WarnAbout(const sdfcage::CageResult& result);
+  void WarnAbout(const sdfcage::CageResult& result, int target, const std::string& prefix = std::string());
   void PublishResults(vtkPolyData* cage) const;
   long long ResultInteger(const char* name) const;
 

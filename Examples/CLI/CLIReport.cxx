@@ -160,6 +160,30 @@ std::string toJson(const RunReport& r)
   key("CageTriangles") << r.CageTriangles;
   key("ReadTime") << jsonNumber(r.ReadTime);
   key("WriteTime") << jsonNumber(r.WriteTime);
+  if (!r.NestedCounts.empty())
+  {
+    std::ostringstream counts;
+    for (std::size_t i = 0; i < r.NestedCounts.size(); ++i)
+      counts << (i ? ", " : "") << r.NestedCounts[i];
+    key("NestedVertexCounts") << "[" << counts.str() << "]";
+    key("NestedLevels") << "[";
+    for (std::size_t k = 0; k < r.Levels.size(); ++k)
+    {
+      const LevelReport& l = r.Levels[k];
+      os << (k ? ",\n    {" : "\n    {") << "\n      \"Name\": " << jsonString(l.Name)
+         << ",\n      \"File\": " << jsonString(l.File) << ",\n      \"Status\": " << jsonString(l.Status)
+         << ",\n      \"Points\": " << l.Points << ",\n      \"Triangles\": " << l.Triangles;
+      bool firstField = false;
+      std::ostringstream fields;
+      writeJsonResults(fields, l.Results, firstField);
+      // writeJsonResults indents by two: one level deeper here
+      std::string text = fields.str();
+      for (std::size_t at = text.find("\n  "); at != std::string::npos; at = text.find("\n  ", at + 7))
+        text.replace(at, 3, "\n      ");
+      os << text << "\n    }";
+    }
+    os << (r.Levels.empty() ? "]" : "\n  ]");
+  }
   // every result of the filter
   writeJsonResults(os, r.Results, first);
   os << "\n}\n";
@@ -274,6 +298,45 @@ void printSummary(std::ostream& os, const RunReport& r)
      << " relative, required >= "
      << number(r.number("ClearanceUsed") > 0 ? r.number("ClearanceUsed") : r.MinimumClearanceUsed) << " relative\n";
   os << "enclosure verified: " << (r.flag("EnclosureVerified") ? "yes" : "no") << "\n";
+  if (!r.NestedCounts.empty())
+  {
+    os << "nested levels (each re-verified against the level inside it and against the input):\n";
+    for (const LevelReport& l : r.Levels)
+    {
+      auto value = [&l](const char* name) {
+        const sdfcage::ResultField* f = sdfcage::findResult(l.Results, name);
+        return f ? f->number() : 0.0;
+      };
+      os << "  " << l.Name << std::string(l.Name.size() < 11 ? 11 - l.Name.size() : 0, ' ') << ": ";
+      if (l.Status == "NotBuilt")
+      {
+        os << "not built\n";
+        continue;
+      }
+      os << l.Points << " points" << (value("TargetReached") != 0 ? "" : " (target NOT reached)") << ", clearance to inside "
+         << number(value("ClearanceToInside")) << ", to input " << number(value("ClearanceToInput")) << ", genus "
+         << static_cast<long long>(value("CageGenus")) << ", " << static_cast<long long>(value("CageComponents"))
+         << " part(s), verified "
+         << (value("VerifiedAgainstInside") != 0 && value("VerifiedAgainstInput") != 0 ? "yes" : "NO") << ", "
+         << seconds(value("LevelTime"));
+      if (!l.File.empty())
+        os << " -> " << l.File;
+      os << "\n";
+    }
+  }
+}
+
+sdfcage::ResultTable levelResultFields()
+{
+  sdfcage::ResultTable t = sdfcage::nestedLevelResults(sdfcage::NestedLevel(), 0);
+  const sdfcage::ResultTable run = sdfcage::cageResults(sdfcage::CageResult());
+  for (const char* name :
+    { "VerticesReached", "TargetReached", "MeasuredClearance", "StopReason", "TopologyWarning", "TotalTime" })
+  {
+    if (const sdfcage::ResultField* f = sdfcage::findResult(run, name))
+      t.push_back(*f);
+  }
+  return t;
 }
 
 void printResults(std::ostream& os, const sdfcage::ResultTable& results)

@@ -2,6 +2,7 @@
 #pragma once
 
 #include "Pipeline/CageGenerator.h"
+#include "Pipeline/NestedCages.h"
 #include "Pipeline/Results.h"
 
 #include <ostream>
@@ -10,6 +11,23 @@
 
 namespace sdfcage_cli
 {
+
+/// One level of a nested run (-n 2000,500,100).
+struct LevelReport
+{
+  int Count = 0;         ///< vertex count asked
+  std::string Name;      ///< "cage_<count>"
+  std::string File;      ///< file written ("" when none; the .vtm/.vtpc when all levels share one)
+  std::string Status;    ///< the level's status ("NotBuilt" when the run stopped before it)
+  long long Points = 0;
+  long long Triangles = 0;
+  /// nestedLevelResults' fields and a few of the level's run (VerticesReached, TargetReached,
+  /// MeasuredClearance, StopReason, TopologyWarning, TotalTime), read from the level's block.
+  sdfcage::ResultTable Results;
+};
+
+/// The fields of LevelReport::Results, with their "nothing" values.
+sdfcage::ResultTable levelResultFields();
 
 /// Everything the program reports. Result fields are named like vtkSDFCageFilter's getters and
 /// the JSON keys are exactly these names.
@@ -43,6 +61,10 @@ struct RunReport
   double GeodesicThreshold = 0.0;
   double AmplificationAlpha = 0.0;
   double AmplificationBeta = 0.0;
+
+  /// Nested levels asked with -n N1,N2,... (sorted, finest first); empty for one cage.
+  std::vector<int> NestedCounts;
+  std::vector<LevelReport> Levels; ///< one per count when nested
 
   // counts
   long long InputPoints = 0;

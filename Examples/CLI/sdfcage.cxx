@@ -1,6 +1,6 @@
 // SDFCage — the command-line program: a surface mesh (or the built-in shape) -> its cage.
 //
-//   sdfcage [INPUT] [-o OUT] [-n N] [--iso C] [--voxel H] [--clearance D] [--adaptivity A]
+//   sdfcage [INPUT] [-o OUT] [-n N | -n N1,N2,...] [--iso C] [--voxel H] [--clearance D] [--adaptivity A]
 //           [--refinements N] [--sign auto|flood|winding|unsigned] [--no-active-points] [--active-radius R] [--geodesic-threshold L]
 //           [--alpha A] [--beta B] [--optimize none|mips|spacing] [--spacing H] [--iterations K]
 //           [--report FILE.json] [--screenshot FILE.png] [--threads N] [--quiet] [--verbose]
@@ -13,15 +13,24 @@
 #include "CLICheck.h"
 #include "CLIMeshIO.h"
 #include "CLIMessages.h"
+#include "CLIMultiBlock.h"
 #include "CLIReport.h"
 #include "CLIScreenshot.h"
 
 #include "Envelope/Envelope.h"      // sdfcage::EnvelopeOptions: what "0 = automatic" resolves to
 #include "Pipeline/CageGenerator.h" // sdfcage::CageResult, for the names of the result table
+#include "Pipeline/NestedCages.h"   // sdfcage::parseNestedCounts, sortNestedCounts
 
 #include <vtkSDFCageFilter.h>
 
+#include <vtkAbstractArray.h>
 #include <vtkCommand.h>
+#include <vtkCompositeDataSet.h>
+#include <vtkDataArray.h>
+#include <vtkFieldData.h>
+#include <vtkInformation.h>
+#include <vtkMultiBlockDataSet.h>
+#include <vtkStringArray.h>
 #include <vtkNew.h>
 #include <vtkPolyData.h>
 #include <vtkSmartPointer.h>
@@ -84,6 +93,12 @@ void printUsage(std::ostream& os)
         "                          current folder\n"
         "  -n, --vertices N        vertices of the cage, default 500; 0 = no simplification\n"
         "                          (the cage is the dense verified envelope)\n"
+        "  -n, --vertices N1,N2,...\n"
+        "                          nested cages (paper 4, Fig. 9): one cage per count, each\n"
+        "                          strictly enclosing the finer ones and the input; one file per\n"
+        "                          level named by its count (-n 1000,300 -o cage.off writes\n"
+        "                          cage_1000.off and cage_300.off), or all levels in one .vtm or\n"
+        "                          .vtpc file\n"
         "      --iso C             isovalue of the envelope, default 0.01\n"
         "      --voxel H           voxel size of the distance grid, default 0 = automatic (C/2)\n"
         "      --clearance D       clearance every cage triangle keeps from the input,\n"
@@ -152,6 +167,7 @@ struct Options
   double Clearance = 0.0;
   double Adaptivity = -1.0; ///< -1 = the filter's default
   int Vertices = -1;        ///< -1 = the filter's default
+  std::vector<int> Nested;  ///< -n N1,N2,...: nested levels, sorted finest first (empty: one cage)
   int Refinements = -1;     ///< -1 = the filter's default
   int Widenings = -1;       ///< -1 = the filter's default
   int TopologyRepairs = -1; ///< -1 = the filter's default
@@ -362,7 +378,25 @@ bool parseBuildOption(ArgumentCursor& a, Options& o, vtkSDFCageFilter* limits)
   else if (arg == "--clearance")
     o.Clearance = a.number(limits->GetMinimumClearanceMinValue(), limits->GetMinimumClearanceMaxValue());
   else if (arg == "-n" || arg == "--vertices")
-    o.Vertices = a.integer(limits->GetTargetNumberOfVerticesMinValue(), limits->GetTargetNumberOfVerticesMaxValue());
+  {
+    const std::string value = a.value();
+    if (value.find(',') == std::string::npos)
+    {
+      o.Vertices = parseInt(
+        arg, value, limits->GetTargetNumberOfVerticesMinValue(), limits->GetTargetNumberOfVerticesMaxValue());
+      o.Nested.clear();
+    }
+    else
+    {
+      std::vector<int> counts;
+      std::string why = sdfcage::parseNestedCounts(value, counts);
+      if (why.empty())
+        why = sdfcage::sortNestedCounts(counts);
+      if (!why.empty())
+        throw UsageError{ arg + ": " + why };
+      o.Nested = counts;
+    }
+  }
   else if (arg == "--adaptivity")
     o.Adaptivity = a.number(limits->GetAdaptivityMinValue(), limits->GetAdaptivityMaxValue());
   else if (arg == "--refinements")
@@ -468,7 +502,16 @@ void finishBuildOptions(Options& o, const std::vector<std::string>& positionals)
   {
     checkSupported(o.Input, "read");
   }
-  if (!o.Output.empty())
+  if (!o.Output.empty() && isMultiBlockExtension(o.Output))
+  {
+    if (o.Nested.empty())
+    {
+      throw UsageError{ "'" + o.Output + "': a " + lowerExtension(o.Output) +
+        " file holds nested cages: give several vertex counts (e.g. -n 2000,500,100), or write one cage as " +
+        supportedExtensions() };
+    }
+  }
+  else if (!o.Output.empty())
   {
     checkSupported(o.Output, "write");
   }
@@ -477,6 +520,25 @@ void finishBuildOptions(Options& o, const std::vector<std::string>& positionals)
     const std::string stem = o.Input.empty() ? std::string("builtin") : std::filesystem::path(o.Input).stem().string();
     o.Output = stem + "_cage.vtp";
   }
+}
+
+/// The files of a nested run: one per level for single-mesh formats, the stem suffixed with the
+/// level's count (cage.off -> cage_1000.off); for .vtm/.vtpc the one file, for every level.
+std::vector<std::string> levelFiles(const Options& o)
+{
+  std::vector<std::string> files;
+  for (int count : o.Nested)
+  {
+    if (isMultiBlockExtension(o.Output))
+    {
+      files.push_back(o.Output);
+      continue;
+    }
+    const std::filesystem::path p(o.Output);
+    std::filesystem::path named = p.parent_path() / (p.stem().string() + "_" + std::to_string(count) + p.extension().string());
+    files.push_back(named.string());
+  }
+  return files;
 }
 
 Options parseOptions(int argc, char* argv[], vtkSDFCageFilter* limits)
@@ -724,6 +786,9 @@ void configureFilter(vtkSDFCageFilter* filter, const Options& o, RunReport& r)
   filter->SetMinimumClearance(o.Clearance);
   if (o.Vertices >= 0)
     filter->SetTargetNumberOfVertices(o.Vertices);
+  filter->SetNumberOfNestedLevels(static_cast<int>(o.Nested.size()));
+  for (std::size_t k = 0; k < o.Nested.size(); ++k)
+    filter->SetNestedVertexCount(static_cast<int>(k), o.Nested[k]);
   if (o.Adaptivity >= 0)
     filter->SetAdaptivity(o.Adaptivity);
   if (o.Refinements >= 0)
@@ -764,7 +829,8 @@ void configureFilter(vtkSDFCageFilter* filter, const Options& o, RunReport& r)
   r.TargetSpacing = filter->GetTargetSpacing();
   r.NumberOfIterations = filter->GetNumberOfIterations();
   r.Adaptivity = filter->GetAdaptivity();
-  r.TargetNumberOfVertices = filter->GetTargetNumberOfVertices();
+  r.TargetNumberOfVertices = o.Nested.empty() ? filter->GetTargetNumberOfVertices() : o.Nested.front();
+  r.NestedCounts = o.Nested;
   r.MaximumRefinements = filter->GetMaximumRefinements();
   r.Sign = o.Sign;
 }
@@ -790,7 +856,10 @@ int interrupted(const Options& o, RunReport& r, ProgressBar* progress)
 /// Every file the run will write can be written: checked before anything is read or computed.
 bool checkOutputs(const Options& o, RunReport& r)
 {
-  for (const std::string* path : { &o.Output, &o.Report, &o.Screenshot })
+  std::vector<std::string> paths = o.Nested.empty() ? std::vector<std::string>{ o.Output } : levelFiles(o);
+  paths.push_back(o.Report);
+  paths.push_back(o.Screenshot);
+  for (const std::string* path = paths.data(); path != paths.data() + paths.size(); ++path)
   {
     std::string error;
     if (!path->empty() && !checkWritable(*path, error))
@@ -823,6 +892,50 @@ void collectResults(vtkSDFCageFilter* filter, RunReport& r)
   r.CageTriangles = cage ? triangleCount(cage) : 0;
   r.EnvelopePoints = envelope ? envelope->GetNumberOfPoints() : 0;
   r.EnvelopeTriangles = envelope ? triangleCount(envelope) : 0;
+
+  // nested levels: one block each, its results in its field data
+  r.Levels.clear();
+  auto* levels = vtkMultiBlockDataSet::SafeDownCast(filter->GetOutputDataObject(3));
+  for (unsigned int b = 0; levels && b < levels->GetNumberOfBlocks() && b < r.NestedCounts.size(); ++b)
+  {
+    LevelReport l;
+    l.Count = r.NestedCounts[b];
+    l.Name = "cage_" + std::to_string(l.Count);
+    l.Results = levelResultFields();
+    vtkPolyData* block = vtkPolyData::SafeDownCast(levels->GetBlock(b));
+    vtkFieldData* fd = block ? block->GetFieldData() : nullptr;
+    auto* status = fd ? vtkStringArray::SafeDownCast(fd->GetAbstractArray("Status")) : nullptr;
+    l.Status = status && status->GetNumberOfValues() > 0 ? status->GetValue(0) : std::string("NotBuilt");
+    l.Points = block ? block->GetNumberOfPoints() : 0;
+    l.Triangles = block ? triangleCount(block) : 0;
+    for (sdfcage::ResultField& f : l.Results)
+    {
+      vtkAbstractArray* a = fd ? fd->GetAbstractArray(f.Name.c_str()) : nullptr;
+      if (!a || a->GetNumberOfValues() < 1)
+        continue;
+      if (auto* s = vtkStringArray::SafeDownCast(a))
+        f.Text = s->GetValue(0);
+      else if (auto* d = vtkDataArray::SafeDownCast(a))
+        f.setNumber(d->GetComponent(0, 0));
+    }
+    r.Levels.push_back(l);
+  }
+}
+
+/// Every level of a nested run was built and re-verified against the level inside it and the
+/// input.
+bool levelsVerified(const RunReport& r)
+{
+  if (r.Levels.size() != r.NestedCounts.size())
+    return false;
+  for (const LevelReport& l : r.Levels)
+  {
+    const sdfcage::ResultField* inside = sdfcage::findResult(l.Results, "VerifiedAgainstInside");
+    const sdfcage::ResultField* input = sdfcage::findResult(l.Results, "VerifiedAgainstInput");
+    if (l.Status != "Ok" || l.Triangles == 0 || !inside || !inside->Integer || !input || !input->Integer)
+      return false;
+  }
+  return true;
 }
 
 /// Prints VTK's warnings of the run (unless quiet) and returns its errors. The filter reports
@@ -929,6 +1042,51 @@ bool writeCage(vtkPolyData* cage, const Options& o, RunReport& r, ProgressBar* p
   return true;
 }
 
+/// --- write, nested: one file per level (or one multi-block file). False (with the status in
+/// `r`) when one cannot be written.
+bool writeLevels(vtkSDFCageFilter* filter, const Options& o, RunReport& r, ProgressBar* progress)
+{
+  const Clock::time_point start = Clock::now();
+  auto* levels = vtkMultiBlockDataSet::SafeDownCast(filter->GetOutputDataObject(3));
+  const std::vector<std::string> files = levelFiles(o);
+  std::string error;
+  auto failed = [&]() {
+    progress->finish();
+    printError(error);
+    r.Status = "WriteFailed";
+    r.ErrorMessage = error;
+    return false;
+  };
+  if (!levels || levels->GetNumberOfBlocks() != files.size())
+  {
+    error = "the nested levels are missing from the filter's output";
+    return failed();
+  }
+  if (isMultiBlockExtension(o.Output))
+  {
+    progress->step("writing " + std::filesystem::path(o.Output).filename().string(), 1.0);
+    if (!writeMultiBlock(levels, o.Output, error))
+      return failed();
+  }
+  else
+  {
+    for (unsigned int b = 0; b < levels->GetNumberOfBlocks(); ++b)
+    {
+      vtkPolyData* block = vtkPolyData::SafeDownCast(levels->GetBlock(b));
+      progress->step("writing " + std::filesystem::path(files[b]).filename().string(), 1.0);
+      const sdfcage::ResultField* clearance = sdfcage::findResult(r.Levels[b].Results, "ClearanceToInside");
+      if (!block || !fitsSinglePrecision(block, files[b], clearance ? clearance->Real : 0.0, error) ||
+        !writeMesh(block, files[b], error))
+        return failed();
+    }
+  }
+  for (std::size_t k = 0; k < r.Levels.size() && k < files.size(); ++k)
+    r.Levels[k].File = files[k];
+  r.WriteTime = since(start);
+  r.OutputFile = isMultiBlockExtension(o.Output) ? o.Output : std::string();
+  return true;
+}
+
 /// --- picture: input and cage (or the unverified envelope, to inspect it) as a PNG. Returns
 /// the exit code, made ExitFailure when rendering fails on an otherwise good run.
 int writePicture(vtkPolyData* input, vtkPolyData* shown, bool verified, const Options& o, RunReport& r,
@@ -1015,7 +1173,8 @@ int run(const Options& o, MessageCollector* messages)
 
   int code = ExitOk;
   vtkPolyData* cage = filter->GetOutput(0);
-  const bool verified = r.Status == "Ok" && r.flag("EnclosureVerified") && r.CageTriangles > 0;
+  const bool verified = r.Status == "Ok" && r.flag("EnclosureVerified") && r.CageTriangles > 0 &&
+    (o.Nested.empty() || levelsVerified(r));
   if (!verified)
   {
     code = ExitNotVerified;
@@ -1023,7 +1182,7 @@ int run(const Options& o, MessageCollector* messages)
     printError(why + " (no cage written)");
     r.ErrorMessage = why;
   }
-  else if (!writeCage(cage, o, r, progress))
+  else if (o.Nested.empty() ? !writeCage(cage, o, r, progress) : !writeLevels(filter, o, r, progress))
   {
     return finish(o, r, ExitFailure);
   }

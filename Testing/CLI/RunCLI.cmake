@@ -6,7 +6,7 @@
 #         [-DEXPECT_FILES="f1|f2"] [-DEXPECT_NO_FILES="f1|f2"]
 #         [-DREPORT=<json>] [-DEXPECT_JSON="Key=value|Key=value"] [-DPYTHON=<python>
 #         -DPNG_CHECK=<check_png.py> -DPNG=<file>]
-#         [-DEXACT_CHECK=<sdfcage_exact_check> -DEXACT_FILES="input|cage"]
+#         [-DEXACT_CHECK=<sdfcage_exact_check> -DEXACT_FILES="input|cage[|input2|cage2...]"]
 #         [-DRESULTS_IN_JSON=ON] -P RunCLI.cmake
 #
 # RESULTS_IN_JSON: the run was --verbose; every result it lists after "results:" (the whole
@@ -300,22 +300,30 @@ if (DEFINED PNG AND NOT failures)
   endif ()
 endif ()
 
-# Independent referee: CGAL's exact predicates on the input and the written cage.
+# Independent referee: CGAL's exact predicates on the input and the written cage. EXACT_FILES
+# holds pairs "input|cage[|input2|cage2...]" (nested cages: each level against the one inside).
 if (DEFINED EXACT_CHECK AND NOT failures)
-  split_bar(pair "${EXACT_FILES}")
+  split_bar(files "${EXACT_FILES}")
   set(paths)
-  foreach (f IN LISTS pair)
+  foreach (f IN LISTS files)
     if (NOT IS_ABSOLUTE "${f}")
       set(f "${WORKDIR}/${f}")
     endif ()
     list(APPEND paths "${f}")
   endforeach ()
-  execute_process(COMMAND "${EXACT_CHECK}" ${paths}
-    RESULT_VARIABLE exactCode OUTPUT_VARIABLE exactOut ERROR_VARIABLE exactErr)
-  message("sdfcage_exact_check: exit code ${exactCode}\n${exactOut}${exactErr}")
-  if (NOT exactCode EQUAL 0)
-    list(APPEND failures "sdfcage_exact_check says the cage does not strictly enclose the input")
-  endif ()
+  list(LENGTH paths npaths)
+  math(EXPR last "${npaths} - 1")
+  foreach (i RANGE 0 ${last} 2)
+    math(EXPR j "${i} + 1")
+    list(GET paths ${i} inputFile)
+    list(GET paths ${j} cageFile)
+    execute_process(COMMAND "${EXACT_CHECK}" "${inputFile}" "${cageFile}"
+      RESULT_VARIABLE exactCode OUTPUT_VARIABLE exactOut ERROR_VARIABLE exactErr)
+    message("sdfcage_exact_check ${inputFile} ${cageFile}: exit code ${exactCode}\n${exactOut}${exactErr}")
+    if (NOT exactCode EQUAL 0)
+      list(APPEND failures "sdfcage_exact_check says ${cageFile} does not strictly enclose ${inputFile}")
+    endif ()
+  endforeach ()
 endif ()
 
 if (failures)

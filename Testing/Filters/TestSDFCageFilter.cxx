@@ -703,7 +703,10 @@ int TestParameters(const Context&)
   filter->SetNumberOfThreads(-3);
   c.Check(filter->GetNumberOfThreads() == 0, "NumberOfThreads is clamped to >= 0");
 
-  c.Check(filter->GetNumberOfOutputPorts() == 3, "three output ports");
+  c.Check(filter->GetNumberOfOutputPorts() == 4, "four output ports");
+  c.Check(std::string(filter->GetOutputPortInformation(3)->Get(vtkDataObject::DATA_TYPE_NAME())) ==
+      "vtkMultiBlockDataSet",
+    "output port 3 (nested levels) is declared as vtkMultiBlockDataSet");
   c.Check(std::string(filter->GetOutputPortInformation(2)->Get(vtkDataObject::DATA_TYPE_NAME())) == "vtkImageData",
     "output port 2 is declared as vtkImageData");
   c.Check(std::string(filter->GetOutputPortInformation(0)->Get(vtkDataObject::DATA_TYPE_NAME())) == "vtkPolyData",

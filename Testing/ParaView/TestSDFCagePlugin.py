@@ -176,6 +176,26 @@ check(o2.GetFieldData().GetAbstractArray("Status").GetValue(0) == "Ok", "SDF Cag
 check(o2.GetFieldData().GetArray("EnergyAfter").GetValue(0) < o2.GetFieldData().GetArray("EnergyBefore").GetValue(0),
       "SDF Cage with Optimize: energy lowered")
 
+# --- nested cages: the Nested Levels list and the Nested Cages output (port 3) ------------------
+nested = SDFCage(Input=sphere, IsoValue=0.04, NestedLevels=[30, 90])
+check(list(SDFCage(Input=sphere).NestedLevels) == [], "Nested Levels is empty by default")
+nested.UpdatePipeline()
+levels = servermanager.Fetch(nested, idx=3)
+check(levels is not None and levels.IsA("vtkMultiBlockDataSet") and levels.GetNumberOfBlocks() == 2,
+      "Nested Cages fetches a vtkMultiBlockDataSet with one block per level")
+if levels is not None and levels.IsA("vtkMultiBlockDataSet") and levels.GetNumberOfBlocks() == 2:
+    for b, n in enumerate((90, 30)):
+        name = levels.GetMetaData(b).Get(levels.NAME())
+        block = levels.GetBlock(b)
+        verified = block.GetFieldData().GetArray("VerifiedAgainstInside")
+        check(name == "cage_%d" % n and block.GetNumberOfPoints() == n
+              and verified is not None and verified.GetValue(0) == 1,
+              "level %d: %s, %d points, verified against the level inside" % (b, name, block.GetNumberOfPoints()))
+check(servermanager.Fetch(nested).GetNumberOfPoints() == 90, "the Cage output is the finest level")
+one_level = servermanager.Fetch(cage, idx=3)
+check(one_level.GetNumberOfBlocks() == 0, "without Nested Levels the Nested Cages output is empty")
+Delete(nested)
+
 # --- OFF writer and reader proxies -------------------------------------------------------------
 path = os.path.join(scratch, "pv_sphere.off")
 if os.path.exists(path):

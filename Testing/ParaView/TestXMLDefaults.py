@@ -98,7 +98,11 @@ def main(xml_path):
         menu = o.find("Hints/ShowInMenu")
         check(menu is not None and menu.get("category") == "Cage Generation", "Cage Optimize in the menu")
     ports = [p.get("name") for p in filter_proxy.findall("OutputPort")]
-    check(ports == ["Cage", "Envelope", "Distance Field"], "named output ports %s" % ports)
+    check(ports == ["Cage", "Envelope", "Distance Field", "Nested Cages"], "named output ports %s" % ports)
+    nested = [p for p in filter_proxy if p.get("name") == "NestedVertexCounts"]
+    check(len(nested) == 1 and nested[0].get("set_number_command") == "SetNumberOfNestedLevels"
+          and nested[0].get("repeat_command") == "1" and nested[0].get("number_of_elements") == "0",
+          "Nested Levels: a repeatable list, empty by default (one cage)")
     menu = filter_proxy.find("Hints/ShowInMenu")
     check(menu is not None and menu.get("category") == "Cage Generation",
           "shown in the Cage Generation menu")
