@@ -44,6 +44,8 @@ constexpr std::size_t MaximumBatch = 256;
 constexpr int LineSearchTries = 8;
 // The first trial step of the line search, relative to the mean edge length around the vertex.
 constexpr double InitialStep = 0.25;
+// The spacing energy's sweeps stop when one lowers it by less than this fraction.
+constexpr double SpacingConvergence = 0.002;
 // The default clearance at the default isovalue (c / 4), for Clearance <= 0.
 constexpr double DefaultClearance = 0.0025;
 
@@ -1153,8 +1155,8 @@ public:
     out.erase(std::unique(out.begin(), out.end()), out.end());
   }
 
-  /// Collapses edge (a, b) (b merged into a, placed at the midpoint, at a, at b or at the
-  /// midpoint lifted along the normal by 0.1, 0.25, 0.5 or 1 times the edge's length: the first
+  /// Collapses edge (a, b) (b merged into a, placed at the midpoint, at a or at b, lifted along
+  /// the region's normal by 0, 0.1, ..., 0.5, 0.75 or 1 times the edge's length: the lowest
   /// that every check accepts and that raises the smallest angle of the region), then splits the
   /// longest edge of the cage with b's index and the two freed triangles. 1 done, 0 not allowed
   /// topologically or no improvement, -1 vetoed. The checks: the link condition; the veto on the
@@ -1211,12 +1213,13 @@ public:
       normal.normalize();
     const double len = (P[b] - P[a]).norm();
     const Vec3 mid = 0.5 * (P[a] + P[b]);
-    const Vec3 positions[7] = { mid, P[a], P[b], mid + 0.1 * len * normal, mid + 0.25 * len * normal,
-      mid + 0.5 * len * normal, mid + len * normal };
+    const Vec3 bases[3] = { mid, P[a], P[b] };
+    const double lifts[8] = { 0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.75, 1.0 };
     bool vetoed = false;
     LocalChangeScratch& s = work().Change;
-    for (const Vec3& p : positions)
+    for (int candidate = 0; candidate < 24; ++candidate)
     {
+      const Vec3 p = bases[candidate % 3] + lifts[candidate / 3] * len * normal;
       s.Tris.resize(changed.size());
       double newMin = 180.0;
       for (std::size_t i = 0; i < changed.size(); ++i)
@@ -1549,8 +1552,9 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
     r.MovesVetoedBySelfIntersection = c[3];
   };
   const int rounds = std::max(0, options.NumberOfIterations);
-  // MIPS: up to MaximumSweeps sweeps per round (the spacing energy: one)
-  const int sweeps = mipsMode ? std::max(1, options.MaximumSweeps) : 1;
+  // up to MaximumSweeps sweeps per round
+  const int sweeps = std::max(1, options.MaximumSweeps);
+  double energy = r.EnergyBefore;
   const bool repair = mipsMode && options.TargetMinimumAngle > 0;
   const std::clock_t cpu0 = std::clock();
   for (int it = 0; it < rounds && !cancelled; ++it)
@@ -1581,7 +1585,15 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
       }
       ++r.Sweeps;
       if (!mipsMode)
-        break;
+      {
+        // the spacing energy: done when a sweep lowers it by less than SpacingConvergence
+        const double e = cageEnergy(opt.mesh(), inputTree, options);
+        const bool converged = !(energy - e > SpacingConvergence * energy);
+        energy = e;
+        if (converged)
+          break;
+        continue;
+      }
       // done when no angle is below the target, or when the sweep changed nothing
       if (minimumAngle(opt.mesh()) >= options.TargetMinimumAngle ||
         (r.Moves == movesBefore && r.Flips == flipsBefore && repairs == 0))

@@ -43,7 +43,7 @@ struct OptimizeOptions
   /// b(g) = -(g - d̂)^2 ln(g / d̂) for g < d̂, 0 beyond. It starts repelling at d = δ + d̂ and is
   /// infinite at d = δ. Default 0.0025 (= δ at the default isovalue).
   double BarrierDistance = 0.0025;
-  /// Rounds of (one relocation pass over every vertex, then one flip pass if EdgeFlips).
+  /// Rounds of sweeps (see MaximumSweeps).
   int NumberOfIterations = 1;
   /// Gradient steps per vertex in one relocation pass.
   int DescentSteps = 2;
@@ -74,8 +74,9 @@ struct OptimizeOptions
   /// (checked like any change) and, to keep the vertex count, the longest edge of the cage is
   /// split at its midpoint (the surface does not change). 0 = no repair.
   double TargetMinimumAngle = 15.0;
-  /// MIPS: sweeps per round (one relocation pass, one flip pass, one repair pass each); a round
-  /// ends early once no angle is below TargetMinimumAngle or a sweep changes nothing.
+  /// Sweeps per round (one relocation pass, one flip pass and, MIPS, one repair pass each). A
+  /// MIPS round ends early once no angle is below TargetMinimumAngle or a sweep changes nothing;
+  /// a spacing round once a sweep lowers the energy by less than 0.2%.
   int MaximumSweeps = 12;
 };
 
@@ -100,7 +101,7 @@ struct OptimizeResult
   long long MovesVetoedByFidelity = 0;         ///< a ring sample went beyond the Hausdorff budget
   long long Collapses = 0;                     ///< needle collapses (each paired with one edge split)
   long long RejectedCollapses = 0;             ///< needle collapses that broke a constraint
-  int Sweeps = 0;                              ///< MIPS sweeps run (over all rounds)
+  int Sweeps = 0;                              ///< sweeps run (over all rounds)
   /// One-sided Hausdorff distance cage -> input (the largest value the branch and bound
   /// reached), unit-sphere units, of the given cage and of the result, and the budget
   /// HausdorffFactor x before (MIPS; 0: off).

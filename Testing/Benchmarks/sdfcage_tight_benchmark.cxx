@@ -104,6 +104,9 @@ int main(int argc, char** argv)
   int threads = 0;
   bool spacing = true;
   bool verbose = false;
+  bool mips = true;
+  int spacingRounds = -1; // < 0: the default
+  int sweeps = -1;        // < 0: the default
   std::string cages;
   std::vector<std::string> files;
   for (int i = 1; i < argc; ++i)
@@ -114,6 +117,12 @@ int main(int argc, char** argv)
       cages = argv[++i];
     else if (!std::strcmp(argv[i], "--threads") && i + 1 < argc)
       threads = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--spacing-rounds") && i + 1 < argc)
+      spacingRounds = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--sweeps") && i + 1 < argc)
+      sweeps = std::atoi(argv[++i]);
+    else if (!std::strcmp(argv[i], "--no-mips"))
+      mips = false;
     else if (!std::strcmp(argv[i], "--verbose"))
       verbose = true;
     else if (!std::strcmp(argv[i], "--no-spacing"))
@@ -171,9 +180,12 @@ int main(int argc, char** argv)
     }
     TriangleMesh input;
     const MeshDefects defects = prepareMesh(polygons, input);
-    if (!defects.usable() || defects.BoundaryEdges > 0 || defects.Components > 1)
+    // closed meshes only (an inward one is flipped): a file that needed repairs (split seams,
+    // degenerate or duplicate faces: a raw scan) is not one
+    if (!defects.usable() || defects.Components > 1 || defects.MergedPoints > 0 ||
+      defects.DroppedDegenerateTriangles > 0 || defects.DroppedDuplicateTriangles > 0 || defects.TriangulatedPolygons > 0)
     {
-      std::printf("%-22s | skipped: not one closed manifold\n", stem(path).c_str());
+      std::printf("%-22s | skipped: not a clean closed mesh\n", stem(path).c_str());
       continue;
     }
     TriangleMesh cage;
@@ -210,6 +222,9 @@ int main(int argc, char** argv)
     const TriangleTree tree(unitInput);
 
     OptimizeOptions o; // the defaults of --optimize mips
+    o.NumberOfIterations = mips ? o.NumberOfIterations : 0;
+    if (sweeps > 0)
+      o.MaximumSweeps = sweeps;
     const OptimizeResult r = optimizeCage(unitCage, unitInput, tree, o);
     const CageQualityResult q0 = evaluateCage(unitInput, unitCage);
     const CageQualityResult q1 = evaluateCage(unitInput, r.Cage);
@@ -230,6 +245,8 @@ int main(int argc, char** argv)
       OptimizeOptions so;
       so.Energy = CageEnergy::Spacing;
       so.TargetSpacing = h;
+      if (spacingRounds >= 0)
+        so.NumberOfIterations = spacingRounds;
       const OptimizeResult s = optimizeCage(unitCage, unitInput, tree, so);
       if (s.State != Status::Ok || s.Reverted)
       {
