@@ -44,6 +44,8 @@ constexpr std::size_t MaximumBatch = 256;
 constexpr int LineSearchTries = 8;
 // The first trial step of the line search, relative to the mean edge length around the vertex.
 constexpr double InitialStep = 0.25;
+// MIPS sweeps stop when the smallest angle has not grown for this many.
+constexpr int StallSweeps = 4;
 // The spacing energy's sweeps stop when one lowers it by less than this fraction.
 constexpr double SpacingConvergence = 0.002;
 // The default clearance at the default isovalue (c / 4), for Clearance <= 0.
@@ -1086,8 +1088,9 @@ public:
     return minimumAngleOf(P[t[0]], P[t[1]], P[t[2]]);
   }
 
-  /// One pass over the triangles with an angle below the target, worst first: a cap (an angle
-  /// above 100 degrees) first tries to flip its longest edge; then the shortest edge is collapsed
+  /// One pass over the triangles with an angle below the target, worst first: a flip of one of
+  /// its edges that raises the pair's smallest angle (the longest edge first); else the shortest
+  /// edge is collapsed
   /// if every constraint allows it, and the longest edge of the cage is split at its midpoint in
   /// exchange (the vertex count stays exact). Returns false when cancelled.
   bool repairPass(OptimizeResult& r, long long& changes)
@@ -1116,18 +1119,24 @@ public:
         ang[k] = cornerAngle(P[t[k]], P[t[(k + 1) % 3]], P[t[(k + 2) % 3]]);
       const int kMin = static_cast<int>(std::min_element(ang, ang + 3) - ang);
       const int kMax = static_cast<int>(std::max_element(ang, ang + 3) - ang);
-      if (ang[kMax] > 100.0)
+      // the flips that raise the pair's smallest angle: the longest edge first (a cap's remedy),
+      // then the others (a needle's neighbour may take its short edge)
+      bool flipped = false;
+      for (int e = 0; e < 3 && !flipped; ++e)
       {
-        const int outcome = tryFlip(t[(kMax + 1) % 3], t[(kMax + 2) % 3], true);
+        const int k = (kMax + e) % 3;
+        const int outcome = tryFlip(t[(k + 1) % 3], t[(k + 2) % 3], true);
         if (outcome > 0)
         {
           ++r.Flips;
           ++changes;
-          continue;
+          flipped = true;
         }
-        if (outcome < 0)
+        else if (outcome < 0)
           ++r.RejectedFlips;
       }
+      if (flipped)
+        continue;
       if (collapsesLeft <= 0)
         continue;
       const int outcome = tryCollapse(t[(kMin + 1) % 3], t[(kMin + 2) % 3]);
@@ -1555,6 +1564,9 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
   // up to MaximumSweeps sweeps per round
   const int sweeps = std::max(1, options.MaximumSweeps);
   double energy = r.EnergyBefore;
+  double bestAngle = r.MinimumAngleBefore;
+  int stalled = 0;
+  TriangleMesh best; // MIPS: the cage after the sweep with the largest smallest angle
   const bool repair = mipsMode && options.TargetMinimumAngle > 0;
   const std::clock_t cpu0 = std::clock();
   for (int it = 0; it < rounds && !cancelled; ++it)
@@ -1594,9 +1606,24 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
           break;
         continue;
       }
-      // done when no angle is below the target, or when the sweep changed nothing
-      if (minimumAngle(opt.mesh()) >= options.TargetMinimumAngle ||
-        (r.Moves == movesBefore && r.Flips == flipsBefore && repairs == 0))
+      // done when no angle is below the target, when the sweep changed nothing, or when the
+      // smallest angle has not grown for StallSweeps sweeps (a needle no change may mend)
+      TriangleMesh now = opt.mesh();
+      const double angle = minimumAngle(now);
+      if (angle > bestAngle + 0.01)
+      {
+        stalled = 0;
+      }
+      else
+        ++stalled;
+      if (angle > bestAngle)
+      {
+        // the best cage so far (every state is valid: each change was checked)
+        bestAngle = angle;
+        best = std::move(now);
+      }
+      if (angle >= options.TargetMinimumAngle || (r.Moves == movesBefore && r.Flips == flipsBefore && repairs == 0) ||
+        stalled >= StallSweeps)
         break;
     }
   }
@@ -1607,6 +1634,10 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
   stage("verifying the optimized cage", 0.9, 1.0);
   const auto t2 = std::chrono::steady_clock::now();
   TriangleMesh result = opt.mesh();
+  // MIPS: the sweeps' smallest angle is not monotone (relocation lowers the sum of the energy);
+  // keep the best cage seen after a sweep
+  if (mipsMode && !best.Triangles.empty() && minimumAngle(result) < bestAngle)
+    result = std::move(best);
   double clearance = 0.0;
   std::vector<double> dist;
   if (verifyEnclosure(input, result, delta, clearance, why, &dist, nullptr, true, &inputTree))

@@ -75,7 +75,8 @@ struct OptimizeOptions
   /// split at its midpoint (the surface does not change). 0 = no repair.
   double TargetMinimumAngle = 15.0;
   /// Sweeps per round (one relocation pass, one flip pass and, MIPS, one repair pass each). A
-  /// MIPS round ends early once no angle is below TargetMinimumAngle or a sweep changes nothing;
+  /// MIPS round ends early once no angle is below TargetMinimumAngle, a sweep changes nothing or
+  /// the smallest angle has not grown for 4 sweeps;
   /// a spacing round once a sweep lowers the energy by less than 0.2%.
   int MaximumSweeps = 12;
 };
