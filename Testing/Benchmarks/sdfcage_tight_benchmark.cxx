@@ -7,10 +7,12 @@
 // the spacing energy the fraction of the cage's area whose distance to the input lies within
 // h +- 20% (h in unit-sphere units, as --spacing).
 //
-//   sdfcage_tight_benchmark [--vertices N] [--cages DIR] [--no-spacing] [--threads N] [--verbose]
-//                          [FILES...]
+//   sdfcage_tight_benchmark [--vertices N] [--cages DIR] [--no-spacing] [--no-mips] [--sweeps K]
+//                           [--spacing-rounds K] [--threads N] [--verbose] [FILES...]
 // --cages DIR: reuse DIR/<stem>_<N>.off as the plain cage when it exists, else generate it
-// (generateCage at the defaults) and write it there; the generation is not timed.
+// (generateCage at the defaults) and write it there; the generation is not timed. --no-mips and
+// --no-spacing skip a part; --sweeps K sets MaximumSweeps of the MIPS run, --spacing-rounds K
+// NumberOfIterations of the spacing runs (defaults otherwise); --verbose adds the MIPS counters.
 #include "Mesh/Normalization.h"
 #include "Mesh/Validation.h"
 #include "MeshIO.h"
@@ -129,8 +131,8 @@ int main(int argc, char** argv)
       spacing = false;
     else if (argv[i][0] == '-')
     {
-      std::printf("usage: sdfcage_tight_benchmark [--vertices N] [--cages DIR] [--no-spacing] [--threads N] "
-                  "[FILES...]\n");
+      std::printf("usage: sdfcage_tight_benchmark [--vertices N] [--cages DIR] [--no-spacing] [--no-mips] "
+                  "[--sweeps K] [--spacing-rounds K] [--threads N] [--verbose] [FILES...]\n");
       return 2;
     }
     else
