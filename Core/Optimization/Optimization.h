@@ -1,7 +1,10 @@
 // SDFCage — Core: cage optimization (paper §3.3). Vertex relocation by gradient descent on
 // E_quality + λ·B (IPC barrier, eq. 7) with a collision-free line search, then edge flips that
-// lower E_quality; every accepted change keeps the clearance to the input, freedom from
-// self-intersection and manifoldness, and the result is verified again at the end.
+// lower E_quality; with MIPS, tangential steps first, a Hausdorff budget on every change and a
+// repair of needles (flips, collapses paired with edge splits), in sweeps until no angle is below
+// the target. Every accepted change keeps the clearance to the input, freedom from
+// self-intersection, manifoldness and the vertex count, and the result is verified again at the
+// end.
 #pragma once
 
 #include "Common/Status.h"
