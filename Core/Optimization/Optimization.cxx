@@ -19,6 +19,7 @@
 #include <ctime>
 #include <cmath>
 #include <cstdint>
+#include <iterator>
 #include <limits>
 
 namespace sdfcage
@@ -43,6 +44,10 @@ constexpr std::size_t MaximumBatch = 256;
 constexpr int LineSearchTries = 8;
 // The first trial step of the line search, relative to the mean edge length around the vertex.
 constexpr double InitialStep = 0.25;
+// MIPS sweeps stop when the smallest angle has not grown for this many.
+constexpr int StallSweeps = 4;
+// The spacing energy's sweeps stop when one lowers it by less than this fraction.
+constexpr double SpacingConvergence = 0.002;
 // The default clearance at the default isovalue (c / 4), for Clearance <= 0.
 constexpr double DefaultClearance = 0.0025;
 
@@ -65,6 +70,64 @@ double barrierDerivative(double g, double dh)
   if (g >= dh || !(g > 0.0))
     return 0.0;
   return -2.0 * (g - dh) * std::log(g / dh) - (g - dh) * (g - dh) / g;
+}
+
+/// The angle at corner a of triangle (a, b, c), degrees.
+double cornerAngle(const Vec3& a, const Vec3& b, const Vec3& c)
+{
+  const Vec3 u = b - a, w = c - a;
+  return std::atan2(u.cross(w).norm(), u.dot(w)) * 180.0 / M_PI;
+}
+double minimumAngleOf(const Vec3& a, const Vec3& b, const Vec3& c)
+{
+  return std::min({ cornerAngle(a, b, c), cornerAngle(b, c, a), cornerAngle(c, a, b) });
+}
+
+// Subdivision depth of the fidelity test and of the Hausdorff bound (a triangle splits into
+// 4^depth at most): at the finest level a cell's centroid stands for it.
+constexpr int FidelityDepth = 5;
+
+/// Is the distance to the input at most `limit` everywhere on triangle (a, b, c)? The distance is
+/// 1-Lipschitz, so a cell whose centroid is at distance d and whose corners lie within R of it
+/// is within d + R: cells are split in four until that settles it; at depth 0 the centroid
+/// decides (the answer may then be off by the cell's R, 1/32 of the triangle's).
+bool triangleWithin(const TriangleTree& tree, const Vec3& a, const Vec3& b, const Vec3& c, double limit, int depth)
+{
+  const Vec3 m = (a + b + c) / 3.0;
+  const double R = std::sqrt(std::max({ (a - m).squaredNorm(), (b - m).squaredNorm(), (c - m).squaredNorm() }));
+  Vec3 y;
+  int t;
+  double d;
+  if (!tree.closestPoint(m, limit, y, t, d) || d > limit)
+    return false;
+  if (d + R <= limit || depth == 0)
+    return true;
+  const Vec3 ab = 0.5 * (a + b), bc = 0.5 * (b + c), ca = 0.5 * (c + a);
+  return triangleWithin(tree, a, ab, ca, limit, depth - 1) && triangleWithin(tree, ab, b, bc, limit, depth - 1) &&
+    triangleWithin(tree, ca, bc, c, limit, depth - 1) && triangleWithin(tree, ab, bc, ca, limit, depth - 1);
+}
+
+/// Branch and bound for the largest distance to the input on triangle (a, b, c): raises `lower`
+/// (a value reached) and `upper` (a bound of the triangle's maximum, to the finest cells' R).
+void triangleFarthest(const TriangleTree& tree, const Vec3& a, const Vec3& b, const Vec3& c, int depth, double& lower,
+  double& upper)
+{
+  const Vec3 m = (a + b + c) / 3.0;
+  const double R = std::sqrt(std::max({ (a - m).squaredNorm(), (b - m).squaredNorm(), (c - m).squaredNorm() }));
+  const double d = tree.distance(m);
+  lower = std::max(lower, d);
+  if (d + R <= lower)
+    return;
+  if (depth == 0)
+  {
+    upper = std::max(upper, d + R);
+    return;
+  }
+  const Vec3 ab = 0.5 * (a + b), bc = 0.5 * (b + c), ca = 0.5 * (c + a);
+  triangleFarthest(tree, a, ab, ca, depth - 1, lower, upper);
+  triangleFarthest(tree, ab, b, bc, depth - 1, lower, upper);
+  triangleFarthest(tree, ca, bc, c, depth - 1, lower, upper);
+  triangleFarthest(tree, ab, bc, ca, depth - 1, lower, upper);
 }
 
 /// MIPS with an equilateral reference, sum(l^2) / (2 sqrt(3) A), and its gradient with respect
@@ -761,6 +824,18 @@ public:
     return v == LocalChangeVerdict::Accepted;
   }
 
+  /// Why descent steps failed (the reason of their last trial): energy not lowered, collision
+  /// (CCD), shape (flip or needle), self-intersection (static test), fidelity (a ring sample
+  /// beyond the Hausdorff budget).
+  enum class Veto
+  {
+    Energy = 0,
+    Collision,
+    Shape,
+    Self,
+    Fidelity
+  };
+
   // ---- one descent step at v: 1 moved, 0 converged (no descent direction), -1 no acceptable step
   /// `reach`: the first trial step (the later ones are shorter, so gathering within it covers
   /// them all). The caller updates the boxes of the ring's triangles after a move.
@@ -771,12 +846,49 @@ public:
     gather(v, reach, L);
     Vec3 g;
     const double e0 = vertexEnergy(L, L.P0, &g);
+    if (!std::isfinite(e0))
+      return -1;
+    Veto worst = Veto::Energy; // the last reason a trial step failed
+    bool tried = false;
+    if (Opt.Energy == CageEnergy::MIPS && Opt.TangentialRelaxation)
+    {
+      // tangential relaxation first: the gradient without its component along the area-weighted
+      // vertex normal (still a descent direction of the whole energy), so the vertex slides
+      // along the cage; where that finds no acceptable step (a crease of a tight cage), the
+      // whole gradient below, the Hausdorff budget bounding how far it may lift the cage
+      Vec3 n = Vec3::Zero();
+      for (const auto& ids : L.RingIds)
+        n += (P[ids[1]] - L.P0).cross(P[ids[2]] - L.P0);
+      const double nn = n.norm();
+      if (nn > 0)
+      {
+        n /= nn;
+        const Vec3 gt = g - g.dot(n) * n;
+        const int outcome = lineSearch(L, e0, gt, reach, worst);
+        if (outcome > 0)
+          return 1;
+        tried = tried || outcome < 0;
+      }
+    }
+    const int outcome = lineSearch(L, e0, g, reach, worst);
+    if (outcome > 0)
+      return 1;
+    if (outcome == 0 && !tried)
+      return 0;
+    ++w.Counts[static_cast<int>(worst)];
+    return -1;
+  }
+
+  /// Backtracking line search of descend() along -g from the vertex of L: 1 moved, 0 no
+  /// descent direction, -1 no acceptable step (the reason of the last trial in `worst`).
+  int lineSearch(Local& L, double e0, const Vec3& g, double reach, Veto& worst)
+  {
+    Work& w = work();
     const double gn = g.norm();
-    if (!std::isfinite(e0) || !(gn > 0) || !std::isfinite(gn))
-      return std::isfinite(e0) ? 0 : -1;
+    if (!(gn > 0) || !std::isfinite(gn))
+      return 0;
     const Vec3 dir = -g / gn;
     double step = reach;
-    Veto worst = Veto::Energy; // the last reason a trial step failed
     for (int k = 0; k < LineSearchTries; ++k, step *= 0.5)
     {
       // energy first (cheaper than the collision test), then the collision-free fraction
@@ -792,7 +904,7 @@ public:
       const double t = advance(L, move);
       if (!(t > 0))
       {
-        ++w.Counts[static_cast<int>(Veto::Collision)];
+        worst = Veto::Collision;
         return -1;
       }
       if (t < 1.0)
@@ -809,22 +921,17 @@ public:
         worst = w.LastVeto;
         continue;
       }
-      P[v] = p;
+      if (!ringWithinBudget(L, p))
+      {
+        worst = Veto::Fidelity;
+        continue;
+      }
+      P[L.V] = p;
       return 1;
     }
-    ++w.Counts[static_cast<int>(worst)];
     return -1;
   }
 
-  /// Why descent steps failed (the reason of their last trial): energy not lowered, collision
-  /// (CCD), shape (flip or needle), self-intersection (static test).
-  enum class Veto
-  {
-    Energy = 0,
-    Collision,
-    Shape,
-    Self
-  };
   /// Per-thread scratch of the relocation (the const queries write only here).
   struct Work
   {
@@ -834,23 +941,25 @@ public:
     std::vector<std::uint64_t> Edges;
     std::vector<int> Points;
     Veto LastVeto = Veto::Shape;
-    long long Counts[4] = { 0, 0, 0, 0 };
+    long long Counts[5] = { 0, 0, 0, 0, 0 };
     LocalChangeScratch Change; ///< the veto's scratch
     std::vector<int> Nearby;   ///< gather()'s cage triangles
   };
   Work& work() const { return Works.local(); }
   /// The veto counts summed over the threads.
-  void counts(long long out[4]) const
+  void counts(long long out[5]) const
   {
-    for (int k = 0; k < 4; ++k)
+    for (int k = 0; k < 5; ++k)
       out[k] = 0;
     for (const Work& w : Works)
-      for (int k = 0; k < 4; ++k)
+      for (int k = 0; k < 5; ++k)
         out[k] += w.Counts[k];
   }
 
   // ---- edge flip of (a, b): 1 flipped, 0 not worth it / not allowed topologically, -1 vetoed
-  int tryFlip(int a, int b)
+  /// `byAngle`: the flip must raise the smaller of the pair's smallest angles instead of
+  /// lowering E_quality (the repair of caps).
+  int tryFlip(int a, int b, bool byAngle = false)
   {
     int f1 = -1, f2 = -1, c = -1, d = -1;
     for (int f : VT[a])
@@ -877,10 +986,24 @@ public:
         if (w == d)
           return 0;
     const Triangle n1{ c, a, d }, n2{ d, b, c };
-    const double before = triangleEnergy(P[a], P[b], P[c], Tree, Opt) + triangleEnergy(P[b], P[a], P[d], Tree, Opt);
-    const double after = triangleEnergy(P[c], P[a], P[d], Tree, Opt) + triangleEnergy(P[d], P[b], P[c], Tree, Opt);
-    if (!(after < before - 1e-12 * std::abs(before)))
-      return 0;
+    if (byAngle)
+    {
+      const double before = std::min(minimumAngleOf(P[a], P[b], P[c]), minimumAngleOf(P[b], P[a], P[d]));
+      const double after = std::min(minimumAngleOf(P[c], P[a], P[d]), minimumAngleOf(P[d], P[b], P[c]));
+      if (!(after > before + 1e-9))
+        return 0;
+    }
+    else
+    {
+      const double before =
+        triangleEnergy(P[a], P[b], P[c], Tree, Opt) + triangleEnergy(P[b], P[a], P[d], Tree, Opt);
+      const double after =
+        triangleEnergy(P[c], P[a], P[d], Tree, Opt) + triangleEnergy(P[d], P[b], P[c], Tree, Opt);
+      if (!(after < before - 1e-12 * std::abs(before)))
+        return 0;
+    }
+    if (!withinBudget(P[c], P[a], P[d]) || !withinBudget(P[d], P[b], P[c]))
+      return -1;
     // the veto: both new triangles at least min(the floor, the worse old one), not flipped
     // against the old pair's mean normal, clear of the input and of the rest of the cage
     const double qBefore = std::min(triangleQuality(P[a], P[b], P[c]), triangleQuality(P[b], P[a], P[d]));
@@ -937,6 +1060,342 @@ public:
     return 1;
   }
 
+  // ---- fidelity: the Hausdorff budget ----------------------------------------------------------
+
+  /// Budget (unit-sphere units) every sample of a changed triangle must stay within; 0 = none.
+  void setBudget(double b) { Budget = b; }
+
+  /// Are all samples of triangle (a, b, c) within the budget of the input?
+  bool withinBudget(const Vec3& a, const Vec3& b, const Vec3& c) const
+  {
+    return !(Budget > 0) || triangleWithin(Tree, a, b, c, Budget, FidelityDepth);
+  }
+
+  /// The ring of v at p within the budget.
+  bool ringWithinBudget(const Local& L, const Vec3& p) const
+  {
+    for (const auto& ids : L.RingIds)
+      if (!withinBudget(p, P[ids[1]], P[ids[2]]))
+        return false;
+    return true;
+  }
+
+  // ---- repair of needles and caps (MIPS) ------------------------------------------------------
+
+  double triangleMinimumAngle(int f) const
+  {
+    const Triangle& t = T[f];
+    return minimumAngleOf(P[t[0]], P[t[1]], P[t[2]]);
+  }
+
+  /// One pass over the triangles with an angle below the target, worst first: a flip of one of
+  /// its edges that raises the pair's smallest angle (the longest edge first); else the shortest
+  /// edge is collapsed
+  /// if every constraint allows it, and the longest edge of the cage is split at its midpoint in
+  /// exchange (the vertex count stays exact). Returns false when cancelled.
+  bool repairPass(OptimizeResult& r, long long& changes)
+  {
+    const double target = Opt.TargetMinimumAngle;
+    std::vector<std::pair<double, int>> bad;
+    for (std::size_t f = 0; f < T.size(); ++f)
+    {
+      const double a = triangleMinimumAngle(static_cast<int>(f));
+      if (a < target)
+        bad.emplace_back(a, static_cast<int>(f));
+    }
+    std::sort(bad.begin(), bad.end());
+    // at most a tenth of the vertices change places per pass (the split vertices need relocation)
+    long long collapsesLeft = std::max<long long>(1, static_cast<long long>(P.size()) / 10);
+    for (std::size_t i = 0; i < bad.size(); ++i)
+    {
+      if (i % 16 == 0 && progressCancelled(Prog))
+        return false;
+      const int f = bad[i].second;
+      if (triangleMinimumAngle(f) >= target)
+        continue; // mended by an earlier change (or its slot reused)
+      const Triangle t = T[f];
+      double ang[3];
+      for (int k = 0; k < 3; ++k)
+        ang[k] = cornerAngle(P[t[k]], P[t[(k + 1) % 3]], P[t[(k + 2) % 3]]);
+      const int kMin = static_cast<int>(std::min_element(ang, ang + 3) - ang);
+      const int kMax = static_cast<int>(std::max_element(ang, ang + 3) - ang);
+      // the flips that raise the pair's smallest angle: the longest edge first (a cap's remedy),
+      // then the others (a needle's neighbour may take its short edge)
+      bool flipped = false;
+      for (int e = 0; e < 3 && !flipped; ++e)
+      {
+        const int k = (kMax + e) % 3;
+        const int outcome = tryFlip(t[(k + 1) % 3], t[(k + 2) % 3], true);
+        if (outcome > 0)
+        {
+          ++r.Flips;
+          ++changes;
+          flipped = true;
+        }
+        else if (outcome < 0)
+          ++r.RejectedFlips;
+      }
+      if (flipped)
+        continue;
+      if (collapsesLeft <= 0)
+        continue;
+      const int outcome = tryCollapse(t[(kMin + 1) % 3], t[(kMin + 2) % 3]);
+      if (outcome > 0)
+      {
+        ++r.Collapses;
+        ++changes;
+        --collapsesLeft;
+      }
+      else if (outcome < 0)
+        ++r.RejectedCollapses;
+    }
+    return true;
+  }
+
+  /// Sorted neighbours of v.
+  void neighbours(int v, std::vector<int>& out) const
+  {
+    out.clear();
+    for (int f : VT[v])
+      for (int w : T[f])
+        if (w != v)
+          out.push_back(w);
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+  }
+
+  /// Collapses edge (a, b) (b merged into a, placed at the midpoint, at a or at b, lifted along
+  /// the region's normal by 0, 0.1, ..., 0.5, 0.75 or 1 times the edge's length: the lowest
+  /// that every check accepts and that raises the smallest angle of the region), then splits the
+  /// longest edge of the cage with b's index and the two freed triangles. 1 done, 0 not allowed
+  /// topologically or no improvement, -1 vetoed. The checks: the link condition; the veto on the
+  /// new triangles (shape, fold, exact input clearance, self-intersection); the Hausdorff budget;
+  /// and no input component swept out of the cage (the winding number of the region between the
+  /// old and the new triangles at one point per component, as the simplifier does).
+  int tryCollapse(int a, int b)
+  {
+    int f1 = -1, f2 = -1, c = -1, d = -1;
+    for (int f : VT[a])
+    {
+      const Triangle& t = T[f];
+      for (int k = 0; k < 3; ++k)
+      {
+        if (t[k] == a && t[(k + 1) % 3] == b)
+        {
+          f1 = f;
+          c = t[(k + 2) % 3];
+        }
+        if (t[k] == b && t[(k + 1) % 3] == a)
+        {
+          f2 = f;
+          d = t[(k + 2) % 3];
+        }
+      }
+    }
+    if (f1 < 0 || f2 < 0 || c == d || VT[c].size() <= 3 || VT[d].size() <= 3)
+      return 0;
+    std::vector<int> na, nb;
+    neighbours(a, na);
+    neighbours(b, nb);
+    if (na.size() + nb.size() <= 6)
+      return 0;
+    std::vector<int> common;
+    std::set_intersection(na.begin(), na.end(), nb.begin(), nb.end(), std::back_inserter(common));
+    if (common.size() != 2) // link condition: only c and d
+      return 0;
+    std::vector<int> changed;
+    for (int v : { a, b })
+      for (int f : VT[v])
+        if (f != f1 && f != f2)
+          changed.push_back(f);
+    std::sort(changed.begin(), changed.end());
+    changed.erase(std::unique(changed.begin(), changed.end()), changed.end());
+    double oldMin = std::min(triangleMinimumAngle(f1), triangleMinimumAngle(f2));
+    for (int f : changed)
+      oldMin = std::min(oldMin, triangleMinimumAngle(f));
+    // where the merged vertex may go: the midpoint, a, b, and (a tight cage on a convex part
+    // would otherwise cut into the clearance) the midpoint lifted along the region's normal
+    Vec3 normal = Vec3::Zero();
+    for (int f : changed)
+      normal += (P[T[f][1]] - P[T[f][0]]).cross(P[T[f][2]] - P[T[f][0]]);
+    if (normal.norm() > 0)
+      normal.normalize();
+    const double len = (P[b] - P[a]).norm();
+    const Vec3 mid = 0.5 * (P[a] + P[b]);
+    const Vec3 bases[3] = { mid, P[a], P[b] };
+    const double lifts[8] = { 0.0, 0.1, 0.2, 0.3, 0.4, 0.5, 0.75, 1.0 };
+    bool vetoed = false;
+    LocalChangeScratch& s = work().Change;
+    for (int candidate = 0; candidate < 24; ++candidate)
+    {
+      const Vec3 p = bases[candidate % 3] + lifts[candidate / 3] * len * normal;
+      s.Tris.resize(changed.size());
+      double newMin = 180.0;
+      for (std::size_t i = 0; i < changed.size(); ++i)
+      {
+        const Triangle& old = T[changed[i]];
+        ChangedTriangle& nt = s.Tris[i];
+        for (int k = 0; k < 3; ++k)
+        {
+          nt.Ids[k] = old[k] == b ? a : old[k];
+          nt.Pts[k] = nt.Ids[k] == a ? p : P[nt.Ids[k]];
+        }
+        nt.Reference = (P[old[1]] - P[old[0]]).cross(P[old[2]] - P[old[0]]);
+        nt.QualityBefore = triangleQuality(P[old[0]], P[old[1]], P[old[2]]);
+        newMin = std::min(newMin, minimumAngleOf(nt.Pts[0], nt.Pts[1], nt.Pts[2]));
+      }
+      if (!(newMin > oldMin + 1e-9))
+        continue;
+      s.Replaced.begin(T.size());
+      s.Replaced.insert(f1);
+      s.Replaced.insert(f2);
+      for (int f : changed)
+        s.Replaced.insert(f);
+      if (FlipVeto.check(s) != LocalChangeVerdict::Accepted)
+      {
+        vetoed = true;
+        continue;
+      }
+      bool ok = true;
+      for (const ChangedTriangle& nt : s.Tris)
+        ok = ok && withinBudget(nt.Pts[0], nt.Pts[1], nt.Pts[2]);
+      if (!ok || sweepsComponent(s.Tris, changed, f1, f2))
+      {
+        vetoed = true;
+        continue;
+      }
+      // commit the collapse: b merges into a at p
+      for (int f : changed)
+        for (int k = 0; k < 3; ++k)
+          if (T[f][k] == b)
+            T[f][k] = a;
+      P[a] = p;
+      VT[a] = changed;
+      VT[b].clear();
+      auto drop = [&](int v, int f) {
+        auto& l = VT[v];
+        l.erase(std::remove(l.begin(), l.end(), f), l.end());
+      };
+      drop(c, f1);
+      drop(d, f2);
+      Grid.remove(f1, Lo[f1], Hi[f1]);
+      Grid.remove(f2, Lo[f2], Hi[f2]);
+      for (int f : changed)
+        updateBox(f);
+      split(b, f1, f2);
+      return 1;
+    }
+    return vetoed ? -1 : 0;
+  }
+
+  /// Would replacing the old triangles (changed, f1, f2) by the new ones s sweep an input
+  /// component out of the cage? Both close the swept region; its winding number at a
+  /// component's representative point (the clearance keeps components off both) decides.
+  bool sweepsComponent(const std::vector<ChangedTriangle>& tris, const std::vector<int>& changed, int f1, int f2) const
+  {
+    Vec3 lo = Vec3::Constant(Inf), hi = -lo;
+    auto grow = [&](int f) {
+      for (int v : T[f])
+      {
+        lo = lo.cwiseMin(P[v]);
+        hi = hi.cwiseMax(P[v]);
+      }
+    };
+    for (int f : changed)
+      grow(f);
+    grow(f1);
+    grow(f2);
+    for (const ChangedTriangle& nt : tris)
+      for (const Vec3& q : nt.Pts)
+      {
+        lo = lo.cwiseMin(q);
+        hi = hi.cwiseMax(q);
+      }
+    for (const Vec3& x : Representatives)
+    {
+      if ((x.array() < lo.array()).any() || (x.array() > hi.array()).any())
+        continue;
+      double angle = 0.0;
+      for (int f : changed)
+        angle += solidAngle(P[T[f][0]], P[T[f][1]], P[T[f][2]], x);
+      angle += solidAngle(P[T[f1][0]], P[T[f1][1]], P[T[f1][2]], x);
+      angle += solidAngle(P[T[f2][0]], P[T[f2][1]], P[T[f2][2]], x);
+      for (const ChangedTriangle& nt : tris)
+        angle -= solidAngle(nt.Pts[0], nt.Pts[1], nt.Pts[2], x);
+      if (std::abs(angle) > 2.0 * M_PI) // |winding number| > 1/2
+        return true;
+    }
+    return false;
+  }
+
+  /// Splits the longest edge of the cage at its midpoint, with the free vertex index m and the
+  /// free triangle slots g3, g4 (those of a collapse). The surface does not change, so every
+  /// constraint still holds.
+  void split(int m, int g3, int g4)
+  {
+    double best = -1.0;
+    int u = -1, w = -1;
+    for (std::size_t f = 0; f < T.size(); ++f)
+    {
+      if (static_cast<int>(f) == g3 || static_cast<int>(f) == g4)
+        continue;
+      const Triangle& t = T[f];
+      for (int k = 0; k < 3; ++k)
+      {
+        const double l = (P[t[(k + 1) % 3]] - P[t[k]]).squaredNorm();
+        if (l > best) // first longest in triangle order: deterministic
+        {
+          best = l;
+          u = t[k];
+          w = t[(k + 1) % 3];
+        }
+      }
+    }
+    int g1 = -1, g2 = -1, e = -1, q = -1;
+    for (int f : VT[u])
+    {
+      const Triangle& t = T[f];
+      for (int k = 0; k < 3; ++k)
+      {
+        if (t[k] == u && t[(k + 1) % 3] == w)
+        {
+          g1 = f;
+          e = t[(k + 2) % 3];
+        }
+        if (t[k] == w && t[(k + 1) % 3] == u)
+        {
+          g2 = f;
+          q = t[(k + 2) % 3];
+        }
+      }
+    }
+    P[m] = 0.5 * (P[u] + P[w]);
+    T[g1] = { u, m, e };
+    T[g3] = { m, w, e };
+    T[g2] = { m, u, q };
+    T[g4] = { w, m, q };
+    auto drop = [&](int v, int f) {
+      auto& l = VT[v];
+      l.erase(std::remove(l.begin(), l.end(), f), l.end());
+    };
+    drop(w, g1);
+    drop(w, g2);
+    VT[w].push_back(g3);
+    VT[w].push_back(g4);
+    VT[e].push_back(g3);
+    VT[q].push_back(g4);
+    VT[m] = { g1, g3, g2, g4 };
+    updateBox(g1);
+    updateBox(g2);
+    for (int f : { g3, g4 })
+    {
+      const Triangle& t = T[f];
+      Lo[f] = P[t[0]].cwiseMin(P[t[1]]).cwiseMin(P[t[2]]);
+      Hi[f] = P[t[0]].cwiseMax(P[t[1]]).cwiseMax(P[t[2]]);
+      Grid.insert(f, Lo[f], Hi[f]);
+    }
+  }
+
   /// Refiles triangle f (moved or flipped) in the grid with its new box.
   void updateBox(int f)
   {
@@ -962,7 +1421,30 @@ private:
   std::vector<Vec3> Representatives; ///< one input point per input component
   mutable tbb::enumerable_thread_specific<Work> Works;
   LocalChangeVeto MoveVeto, FlipVeto; ///< read P, T, Lo, Hi and Grid
+  double Budget = 0.0;                ///< the Hausdorff budget (0: none)
 };
+
+/// One-sided Hausdorff distance cage -> input by branch and bound (the largest value reached;
+/// the bound is at most 1/32 of the largest triangle's size above it), and the fraction of
+/// triangle angles below `angle` degrees.
+double sampledHausdorff(const TriangleMesh& cage, const TriangleTree& tree)
+{
+  double lower = 0.0, upper = 0.0;
+  for (const Triangle& t : cage.Triangles)
+    for (int v : t)
+      lower = std::max(lower, tree.distance(cage.Points[v]));
+  for (const Triangle& t : cage.Triangles)
+    triangleFarthest(tree, cage.Points[t[0]], cage.Points[t[1]], cage.Points[t[2]], FidelityDepth, lower, upper);
+  return lower;
+}
+double smallAngleFraction(const TriangleMesh& cage, double angle)
+{
+  long long n = 0;
+  for (const Triangle& t : cage.Triangles)
+    for (int k = 0; k < 3; ++k)
+      n += cornerAngle(cage.Points[t[k]], cage.Points[t[(k + 1) % 3]], cage.Points[t[(k + 2) % 3]]) < angle;
+  return cage.Triangles.empty() ? 0.0 : double(n) / double(3 * cage.Triangles.size());
+}
 
 } // namespace
 
@@ -1024,6 +1506,13 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
     r.Message = "TargetSpacing, BarrierWeight and BarrierDistance must be finite and >= 0";
     return r;
   }
+  if (!(options.HausdorffFactor == 0 || (options.HausdorffFactor >= 1 && std::isfinite(options.HausdorffFactor))) ||
+    !(options.TargetMinimumAngle >= 0 && options.TargetMinimumAngle < 60))
+  {
+    r.State = Status::InvalidInput;
+    r.Message = "HausdorffFactor must be 0 (off) or >= 1, TargetMinimumAngle in [0, 60)";
+    return r;
+  }
   // the given cage must already satisfy the guarantees; measure its clearance
   stage("verifying the given cage", 0.0, 0.05);
   std::string why;
@@ -1050,32 +1539,92 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
   r.ClearanceUsed = delta;
   r.EnergyBefore = cageEnergy(cage, inputTree, options);
   r.MinimumAngleBefore = minimumAngle(cage);
+  const bool mipsMode = options.Energy == CageEnergy::MIPS;
+  r.SmallAnglesBefore = smallAngleFraction(cage, options.TargetMinimumAngle);
+  r.HausdorffBefore = sampledHausdorff(cage, inputTree);
   r.VerificationSeconds = seconds(tv);
 
   Optimizer opt(cage, input, inputTree, options, delta, selfDelta, progress);
+  if (mipsMode && options.HausdorffFactor > 0)
+  {
+    r.HausdorffBudget = options.HausdorffFactor * r.HausdorffBefore;
+    opt.setBudget(r.HausdorffBudget);
+  }
   bool cancelled = false;
   const auto copyCounts = [&]() {
-    long long c[4];
+    long long c[5];
     opt.counts(c);
+    r.MovesVetoedByFidelity = c[4];
     r.MovesWithoutDescent = c[0];
     r.MovesCutByCollision = c[1];
     r.MovesVetoedByShape = c[2];
     r.MovesVetoedBySelfIntersection = c[3];
   };
   const int rounds = std::max(0, options.NumberOfIterations);
+  // up to MaximumSweeps sweeps per round
+  const int sweeps = std::max(1, options.MaximumSweeps);
+  double energy = r.EnergyBefore;
+  double bestAngle = r.MinimumAngleBefore;
+  int stalled = 0;
+  TriangleMesh best; // MIPS: the cage after the sweep with the largest smallest angle
+  const bool repair = mipsMode && options.TargetMinimumAngle > 0;
   const std::clock_t cpu0 = std::clock();
   for (int it = 0; it < rounds && !cancelled; ++it)
   {
-    stage("relocating cage vertices", 0.05 + 0.85 * it / rounds, 0.05 + 0.85 * (it + 0.8) / rounds);
-    const auto t0 = std::chrono::steady_clock::now();
-    cancelled = !opt.relocationPass(r, 0.0, 1.0);
-    r.RelocationSeconds += seconds(t0);
-    if (!cancelled && options.EdgeFlips)
+    for (int sw = 0; sw < sweeps && !cancelled; ++sw)
     {
-      stage("flipping cage edges", 0.05 + 0.85 * (it + 0.8) / rounds, 0.05 + 0.85 * (it + 1.0) / rounds);
-      const auto t1 = std::chrono::steady_clock::now();
-      cancelled = !opt.flipPass(r);
-      r.FlipSeconds += seconds(t1);
+      const double b = 0.05 + 0.85 * (it + double(sw) / sweeps) / rounds;
+      const double e = 0.05 + 0.85 * (it + double(sw + 1) / sweeps) / rounds;
+      const long long movesBefore = r.Moves, flipsBefore = r.Flips;
+      long long repairs = 0;
+      stage("relocating cage vertices", b, b + 0.8 * (e - b));
+      const auto t0 = std::chrono::steady_clock::now();
+      cancelled = !opt.relocationPass(r, 0.0, 1.0);
+      r.RelocationSeconds += seconds(t0);
+      if (!cancelled && options.EdgeFlips)
+      {
+        stage("flipping cage edges", b + 0.8 * (e - b), b + 0.9 * (e - b));
+        const auto t1 = std::chrono::steady_clock::now();
+        cancelled = !opt.flipPass(r);
+        r.FlipSeconds += seconds(t1);
+      }
+      if (!cancelled && repair)
+      {
+        stage("repairing needles", b + 0.9 * (e - b), e);
+        const auto t1 = std::chrono::steady_clock::now();
+        cancelled = !opt.repairPass(r, repairs);
+        r.FlipSeconds += seconds(t1);
+      }
+      ++r.Sweeps;
+      if (!mipsMode)
+      {
+        // the spacing energy: done when a sweep lowers it by less than SpacingConvergence
+        const double e = cageEnergy(opt.mesh(), inputTree, options);
+        const bool converged = !(energy - e > SpacingConvergence * energy);
+        energy = e;
+        if (converged)
+          break;
+        continue;
+      }
+      // done when no angle is below the target, when the sweep changed nothing, or when the
+      // smallest angle has not grown for StallSweeps sweeps (a needle no change may mend)
+      TriangleMesh now = opt.mesh();
+      const double angle = minimumAngle(now);
+      if (angle > bestAngle + 0.01)
+      {
+        stalled = 0;
+      }
+      else
+        ++stalled;
+      if (angle > bestAngle)
+      {
+        // the best cage so far (every state is valid: each change was checked)
+        bestAngle = angle;
+        best = std::move(now);
+      }
+      if (angle >= options.TargetMinimumAngle || (r.Moves == movesBefore && r.Flips == flipsBefore && repairs == 0) ||
+        stalled >= StallSweeps)
+        break;
     }
   }
 
@@ -1085,6 +1634,10 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
   stage("verifying the optimized cage", 0.9, 1.0);
   const auto t2 = std::chrono::steady_clock::now();
   TriangleMesh result = opt.mesh();
+  // MIPS: the sweeps' smallest angle is not monotone (relocation lowers the sum of the energy);
+  // keep the best cage seen after a sweep
+  if (mipsMode && !best.Triangles.empty() && minimumAngle(result) < bestAngle)
+    result = std::move(best);
   double clearance = 0.0;
   std::vector<double> dist;
   if (verifyEnclosure(input, result, delta, clearance, why, &dist, nullptr, true, &inputTree))
@@ -1106,6 +1659,8 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
   r.VerificationSeconds += seconds(t2);
   r.EnergyAfter = cageEnergy(r.Cage, inputTree, options);
   r.MinimumAngleAfter = minimumAngle(r.Cage);
+  r.SmallAnglesAfter = smallAngleFraction(r.Cage, options.TargetMinimumAngle);
+  r.HausdorffAfter = sampledHausdorff(r.Cage, inputTree);
   r.State = cancelled ? Status::Cancelled : Status::Ok;
   if (cancelled && r.Message.empty())
     r.Message = "cancelled during optimization; the cage so far is valid";

@@ -1,7 +1,10 @@
 // SDFCage — Core: cage optimization (paper §3.3). Vertex relocation by gradient descent on
 // E_quality + λ·B (IPC barrier, eq. 7) with a collision-free line search, then edge flips that
-// lower E_quality; every accepted change keeps the clearance to the input, freedom from
-// self-intersection and manifoldness, and the result is verified again at the end.
+// lower E_quality; with MIPS, tangential steps first, a Hausdorff budget on every change and a
+// repair of needles (flips, collapses paired with edge splits), in sweeps until no angle is below
+// the target. Every accepted change keeps the clearance to the input, freedom from
+// self-intersection, manifoldness and the vertex count, and the result is verified again at the
+// end.
 #pragma once
 
 #include "Common/Status.h"
@@ -43,7 +46,7 @@ struct OptimizeOptions
   /// b(g) = -(g - d̂)^2 ln(g / d̂) for g < d̂, 0 beyond. It starts repelling at d = δ + d̂ and is
   /// infinite at d = δ. Default 0.0025 (= δ at the default isovalue).
   double BarrierDistance = 0.0025;
-  /// Rounds of (one relocation pass over every vertex, then one flip pass if EdgeFlips).
+  /// Rounds of sweeps (see MaximumSweeps).
   int NumberOfIterations = 1;
   /// Gradient steps per vertex in one relocation pass.
   int DescentSteps = 2;
@@ -57,6 +60,28 @@ struct OptimizeOptions
   /// A changed triangle's quality 4 sqrt(3) A / sum(l^2) (1 equilateral) must stay at least
   /// min(this, its quality before the change).
   double MinimumTriangleQuality = 0.02;
+
+  // ---- keeping the MIPS-optimized cage tight (ignored by the spacing energy) ----
+  /// MIPS: vertices move in their tangent plane only (the MIPS gradient with its component along
+  /// the area-weighted vertex normal removed), so relaxation slides triangles along the cage
+  /// instead of inflating it; the barrier and the line search are unchanged.
+  bool TangentialRelaxation = true;
+  /// MIPS fidelity: no change (move, flip, collapse) may put a point of a changed triangle
+  /// farther from the input than this times the given cage's one-sided Hausdorff distance
+  /// cage -> input. Both by branch and bound on the 1-Lipschitz distance (cells split to 1/32 of
+  /// the triangle; the finest cells judged at their centroids, so the result may exceed the
+  /// budget by about that much). 0 = off, else >= 1.
+  double HausdorffFactor = 1.4;
+  /// MIPS: the smallest angle (degrees) the sweeps aim at. Triangles with a smaller angle are
+  /// repaired when relocation and flips leave them: the shortest edge of a needle is collapsed
+  /// (checked like any change) and, to keep the vertex count, the longest edge of the cage is
+  /// split at its midpoint (the surface does not change). 0 = no repair.
+  double TargetMinimumAngle = 15.0;
+  /// Sweeps per round (one relocation pass, one flip pass and, MIPS, one repair pass each). A
+  /// MIPS round ends early once no angle is below TargetMinimumAngle, a sweep changes nothing or
+  /// the smallest angle has not grown for 4 sweeps;
+  /// a spacing round once a sweep lowers the energy by less than 0.2%.
+  int MaximumSweeps = 12;
 };
 
 struct OptimizeResult
@@ -77,6 +102,18 @@ struct OptimizeResult
   long long MovesCutByCollision = 0;           ///< the CCD allowed nothing (or too little to lower it),
   long long MovesVetoedByShape = 0;            ///< a ring triangle would flip or become a needle,
   long long MovesVetoedBySelfIntersection = 0; ///< the static self-intersection test failed
+  long long MovesVetoedByFidelity = 0;         ///< a ring sample went beyond the Hausdorff budget
+  long long Collapses = 0;                     ///< needle collapses (each paired with one edge split)
+  long long RejectedCollapses = 0;             ///< needle collapses that broke a constraint
+  int Sweeps = 0;                              ///< sweeps run (over all rounds)
+  /// One-sided Hausdorff distance cage -> input (the largest value the branch and bound
+  /// reached), unit-sphere units, of the given cage and of the result, and the budget
+  /// HausdorffFactor x before (MIPS; 0: off).
+  double HausdorffBefore = 0.0;
+  double HausdorffAfter = 0.0;
+  double HausdorffBudget = 0.0;
+  double SmallAnglesBefore = 0.0; ///< fraction of triangle angles below TargetMinimumAngle (MIPS)
+  double SmallAnglesAfter = 0.0;
   long long Batches = 0;                       ///< relocation batches (vertices relocated in parallel)
   long long Flips = 0;
   long long RejectedFlips = 0; ///< flips that would lower the energy but break a constraint

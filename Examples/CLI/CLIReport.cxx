@@ -291,7 +291,10 @@ void printSummary(std::ostream& os, const RunReport& r)
   {
     os << "optimization: " << r.Optimize << " energy " << number(r.number("EnergyBefore")) << " -> "
        << number(r.number("EnergyAfter")) << ", " << r.NumberOfIterations << " iteration(s), "
-       << seconds(r.number("OptimizationTime")) << "\n";
+       << seconds(r.number("OptimizationTime")) << "\n"
+       << "              min angle " << number(r.number("MinimumAngleBefore")) << " -> "
+       << number(r.number("MinimumAngleAfter")) << " deg, Hausdorff cage->input " << number(r.number("HausdorffBefore"))
+       << " -> " << number(r.number("HausdorffAfter")) << " relative\n";
   }
   os << "clearance   : " << number(r.number("MeasuredClearance"))
      << " (input units) = " << number(r.number("MeasuredClearanceRelative"))

@@ -6,6 +6,7 @@
 #include "Spatial/Geometry.h"
 #include "Mesh/Normalization.h"
 #include "Optimization/Optimization.h"
+#include "Quality/CageQuality.h"
 #include "Common/Progress.h"
 #include "Mesh/Shapes.h"
 #include "Spatial/TriangleTree.h"
@@ -135,6 +136,45 @@ TEST(Optimization, MIPSImprovesBadTriangles)
   const TriangleTree tree(input);
   EXPECT_NEAR(cageEnergy(r.Cage, tree, o), r.EnergyAfter, 1e-9 * r.EnergyAfter);
   EXPECT_NEAR(cageEnergy(cage, tree, o), r.EnergyBefore, 1e-9 * r.EnergyBefore);
+}
+
+TEST(Optimization, MIPSReachesFifteenDegreesAndStaysTight)
+{
+  // issue 15 part 3 at the defaults: no angle below 15 degrees, the one-sided Hausdorff distance
+  // cage -> input (certified by the quality judge) at most 1.5 times the plain cage's, and every
+  // guarantee (judged by the exact CGAL checker in expectGuarantees)
+  struct Shape
+  {
+    const char* Name;
+    TriangleMesh Mesh;
+  };
+  const Shape shapes[] = { { "builtin", makeBuiltinShape() }, { "torus", makeTorus(Vec3(0, 0, 0), 1.0, 0.3, 64, 24) } };
+  for (const Shape& s : shapes)
+  {
+    const CageResult cage = makeCage(s.Mesh, 500);
+    ASSERT_EQ(cage.State, Status::Ok) << s.Name << ": " << cage.Message;
+    OptimizeOptions o; // the defaults of --optimize mips
+    ASSERT_EQ(o.Energy, CageEnergy::MIPS);
+    ASSERT_EQ(o.NumberOfIterations, 1);
+    o.Clearance = CageOptions().Envelope.clearance();
+    const OptimizeResult r = optimizeCageInInputUnits(cage.Cage, s.Mesh, o);
+    const double delta = cage.Normalize.lengthToInput(o.Clearance);
+    expectGuarantees(s.Mesh, cage.Cage, r, delta, std::string(s.Name) + " MIPS at the defaults");
+    const CageQualityResult q0 = evaluateCage(s.Mesh, cage.Cage);
+    const CageQualityResult q1 = evaluateCage(s.Mesh, r.Cage);
+    std::cout << "[ tight    ] " << s.Name << ": min angle " << minimumAngle(cage.Cage) << " -> " << r.MinimumAngleAfter
+              << " deg, angles < 15: " << 100 * r.SmallAnglesBefore << "% -> " << 100 * r.SmallAnglesAfter
+              << "%, Hausdorff cage->input " << q0.HausdorffCageToInputBound << " -> " << q1.HausdorffCageToInputBound
+              << " (x" << q1.HausdorffCageToInputBound / q0.HausdorffCageToInputBound << "), " << r.Sweeps
+              << " sweeps, " << r.Collapses << " collapse+split pairs, " << r.Seconds << " s\n";
+    EXPECT_LT(r.MinimumAngleBefore, 15.0) << s.Name << ": the plain cage must have needles for this to test anything";
+    EXPECT_GE(r.MinimumAngleAfter, 15.0) << s.Name;
+    EXPECT_NEAR(r.MinimumAngleAfter, minimumAngle(r.Cage), 1e-9) << s.Name;
+    EXPECT_EQ(r.SmallAnglesAfter, 0.0) << s.Name;
+    EXPECT_LE(q1.HausdorffCageToInputBound, 1.5 * q0.HausdorffCageToInputBound) << s.Name;
+    // the budget the optimizer enforced is the one it reports
+    EXPECT_NEAR(r.HausdorffBudget, o.HausdorffFactor * r.HausdorffBefore, 1e-12) << s.Name;
+  }
 }
 
 TEST(Optimization, SpacingConcentratesAroundTarget)
