@@ -65,8 +65,11 @@ struct EnvelopeOptions
   /// voxels in the narrow band and 4x fewer isosurface cells). Its envelope is kept only when it
   /// is verified like any other and has the input's genus and parts; otherwise the requested
   /// grid (IsoValue / 2) follows as if the coarse one had not been tried. Refinements counts the
-  /// grids finer than the requested one only.
-  bool CoarseFirst = true;
+  /// grids finer than the requested one only. Off by default: on the shared meshes it makes
+  /// closed inputs 1.2-2.6x faster with cages as tight within +-15%, but the fertility cage it
+  /// gives is meshed by `tetgen -pQ` with a volume 8e-6 short of cage minus input (every other
+  /// cage matches to 1e-6; the cage itself passes the exact referee): not understood yet.
+  bool CoarseFirst = false;
   /// Measure the envelope's exact minimum clearance (costly on a dense envelope) instead of
   /// certifying that it is at least the clearance (a certified lower bound is reported then).
   bool ExactEnvelopeClearance = false;
