@@ -1,0 +1,320 @@
+// Cancel latency of vtkSDFCageFilter: from the abort request to the return of Update(), per
+// stage, and what the cancelled run outputs.
+//
+// The abort is requested the way ParaView's Cancel button and the sdfcage program's Ctrl-C do it:
+// a flag set asynchronously (here by a timer thread) that a ProgressEvent observer turns into
+// SetAbortExecute(1). So the latency includes the time until the filter next fires a progress
+// event, and then until Core's next cancel check answers. One uninterrupted run first gives the
+// total time T; then try i (of N) requests the abort at T·(i + 0.5)/N. The stage of a try is the
+// filter's progress text at the moment of the request.
+//
+// After each cancelled run the cage output must be empty or a cage that the exact checker
+// (CGAL, Testing/Exact) finds closed, 2-manifold, self-intersection free and enclosing the input:
+// a broken one makes the program exit with 1. A benchmark (prints figures), not a timed test.
+//
+//   sdfcage_cancel_benchmark [MESH] [--tries N] [--threads T] [--vertices V] [--optimize]
+//                            [--builtin] [--no-check]
+//   (default MESH: SDFCAGE_DATA_DIR/armadillo_midsub4x.obj)
+#include "vtkSDFCageFilter.h"
+
+#include "MeshIO.h"
+#include "ExactCheck.h"
+#include "Mesh/Shapes.h"
+
+#include "vtkCallbackCommand.h"
+#include "vtkCellArray.h"
+#include "vtkIdList.h"
+#include "vtkNew.h"
+#include "vtkPoints.h"
+#include "vtkPolyData.h"
+#include "vtkSmartPointer.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <condition_variable>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <map>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+namespace
+{
+using Clock = std::chrono::steady_clock;
+
+double since(Clock::time_point t0, Clock::time_point t1 = Clock::now())
+{
+  return std::chrono::duration<double>(t1 - t0).count();
+}
+
+vtkSmartPointer<vtkPolyData> toPolyData(const sdfcage::PolygonMesh& mesh)
+{
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(static_cast<vtkIdType>(mesh.Points.size()));
+  for (std::size_t i = 0; i < mesh.Points.size(); ++i)
+    points->SetPoint(static_cast<vtkIdType>(i), mesh.Points[i].data());
+  vtkNew<vtkCellArray> polys;
+  for (std::size_t c = 0; c < mesh.numberOfCells(); ++c)
+  {
+    polys->InsertNextCell(static_cast<int>(mesh.Offsets[c + 1] - mesh.Offsets[c]));
+    for (std::int64_t k = mesh.Offsets[c]; k < mesh.Offsets[c + 1]; ++k)
+      polys->InsertCellPoint(static_cast<vtkIdType>(mesh.Connectivity[k]));
+  }
+  auto out = vtkSmartPointer<vtkPolyData>::New();
+  out->SetPoints(points);
+  out->SetPolys(polys);
+  return out;
+}
+
+sdfcage::TriangleMesh toTriangles(vtkPolyData* pd)
+{
+  sdfcage::TriangleMesh m;
+  for (vtkIdType i = 0; i < pd->GetNumberOfPoints(); ++i)
+  {
+    double p[3];
+    pd->GetPoint(i, p);
+    m.Points.emplace_back(p[0], p[1], p[2]);
+  }
+  vtkNew<vtkIdList> ids;
+  vtkCellArray* polys = pd->GetPolys();
+  for (polys->InitTraversal(); polys->GetNextCell(ids);)
+  {
+    for (vtkIdType k = 1; k + 1 < ids->GetNumberOfIds(); ++k)
+      m.Triangles.push_back({ static_cast<int>(ids->GetId(0)), static_cast<int>(ids->GetId(k)),
+        static_cast<int>(ids->GetId(k + 1)) });
+  }
+  return m;
+}
+
+struct Options
+{
+  std::string Mesh = std::string(SDFCAGE_DATA_DIR) + "/armadillo_midsub4x.obj";
+  bool Builtin = false;
+  int Tries = 20;
+  int Threads = 0;
+  int Vertices = -1;
+  bool Optimize = false;
+  bool Check = true;
+};
+
+/// What one run saw: the progress texts with their times, and (for a cancelled run) the time of
+/// the request.
+struct RunRecord
+{
+  Clock::time_point Start;
+  std::mutex Lock;
+  std::vector<std::pair<double, std::string>> Texts; ///< (seconds since start, progress text)
+  std::atomic<bool> AbortRequested{ false };
+  double RequestedAt = -1.0;
+  int Events = 0;
+  double LongestEventGap = 0.0; ///< seconds between consecutive progress events, the longest
+  double LastEvent = 0.0;
+};
+
+void onProgress(vtkObject* caller, unsigned long, void* clientData, void*)
+{
+  auto* record = static_cast<RunRecord*>(clientData);
+  auto* filter = static_cast<vtkSDFCageFilter*>(caller);
+  const double t = since(record->Start);
+  {
+    std::lock_guard<std::mutex> lock(record->Lock);
+    const char* text = filter->GetProgressText();
+    const std::string s = text ? text : "";
+    if (record->Texts.empty() || record->Texts.back().second != s)
+      record->Texts.emplace_back(t, s);
+    record->LongestEventGap = std::max(record->LongestEventGap, t - record->LastEvent);
+    record->LastEvent = t;
+    ++record->Events;
+  }
+  if (record->AbortRequested.load())
+    filter->SetAbortExecute(1);
+}
+
+/// The stage (progress text) current at `t` seconds.
+std::string stageAt(RunRecord& r, double t)
+{
+  std::lock_guard<std::mutex> lock(r.Lock);
+  std::string s = "start";
+  for (const auto& e : r.Texts)
+  {
+    if (e.first > t)
+      break;
+    s = e.second;
+  }
+  return s.empty() ? "start" : s;
+}
+
+vtkSmartPointer<vtkSDFCageFilter> makeFilter(vtkPolyData* input, const Options& o, RunRecord& record)
+{
+  auto filter = vtkSmartPointer<vtkSDFCageFilter>::New();
+  filter->SetInputData(input);
+  filter->SetNumberOfThreads(o.Threads);
+  if (o.Vertices >= 0)
+    filter->SetTargetNumberOfVertices(o.Vertices);
+  filter->SetOptimize(o.Optimize ? 1 : 0);
+  vtkNew<vtkCallbackCommand> observer;
+  observer->SetCallback(onProgress);
+  observer->SetClientData(&record);
+  filter->AddObserver(vtkCommand::ProgressEvent, observer);
+  return filter;
+}
+
+double median(std::vector<double> v)
+{
+  std::sort(v.begin(), v.end());
+  const std::size_t n = v.size();
+  return n == 0 ? 0.0 : n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+} // namespace
+
+int main(int argc, char* argv[])
+{
+  Options o;
+  for (int i = 1; i < argc; ++i)
+  {
+    const std::string a = argv[i];
+    auto next = [&]() -> const char* {
+      if (i + 1 >= argc)
+      {
+        std::fprintf(stderr, "%s needs a value\n", a.c_str());
+        std::exit(2);
+      }
+      return argv[++i];
+    };
+    if (a == "--tries")
+      o.Tries = std::max(1, std::atoi(next()));
+    else if (a == "--threads")
+      o.Threads = std::max(0, std::atoi(next()));
+    else if (a == "--vertices")
+      o.Vertices = std::atoi(next());
+    else if (a == "--optimize")
+      o.Optimize = true;
+    else if (a == "--builtin")
+      o.Builtin = true;
+    else if (a == "--no-check")
+      o.Check = false;
+    else if (a == "-h" || a == "--help")
+    {
+      std::printf("usage: sdfcage_cancel_benchmark [MESH] [--tries N] [--threads T] [--vertices V] [--optimize] "
+                  "[--builtin] [--no-check]\n");
+      return 0;
+    }
+    else if (!a.empty() && a[0] == '-')
+    {
+      std::fprintf(stderr, "unknown option %s\n", a.c_str());
+      return 2;
+    }
+    else
+      o.Mesh = a;
+  }
+
+  sdfcage::PolygonMesh mesh;
+  std::string name = "builtin";
+  if (o.Builtin)
+    mesh = sdfcage::PolygonMesh::fromTriangles(sdfcage::makeBuiltinShape());
+  else
+  {
+    std::string error;
+    if (!sdfcage::exact::readPolygonMesh(o.Mesh, mesh, error))
+    {
+      std::fprintf(stderr, "cannot read %s: %s\n", o.Mesh.c_str(), error.c_str());
+      return 2;
+    }
+    name = o.Mesh.substr(o.Mesh.find_last_of('/') + 1);
+  }
+  vtkSmartPointer<vtkPolyData> input = toPolyData(mesh);
+  sdfcage::TriangleMesh inputTriangles;
+  sdfcage::exact::fanTriangulate(mesh, inputTriangles);
+
+  // the uninterrupted run: total time and the stages' start times
+  double total = 0.0;
+  {
+    RunRecord record;
+    auto filter = makeFilter(input, o, record);
+    record.Start = Clock::now();
+    filter->Update();
+    total = since(record.Start);
+    std::printf("%s, uninterrupted: %.2f s, status %s, %lld cage vertices, %d progress events (longest gap %.3f s)\n",
+      name.c_str(), total, filter->GetStatusString(), static_cast<long long>(filter->GetOutput()->GetNumberOfPoints()),
+      record.Events, record.LongestEventGap);
+    std::printf("stages:");
+    for (const auto& e : record.Texts)
+      std::printf(" %.2f %s;", e.first, e.second.c_str());
+    std::printf("\n");
+  }
+
+  std::map<std::string, std::vector<double>> latencies;
+  std::vector<std::string> order;
+  int broken = 0;
+  double worst = 0.0;
+  for (int i = 0; i < o.Tries; ++i)
+  {
+    const double at = total * (i + 0.5) / o.Tries;
+    RunRecord record;
+    auto filter = makeFilter(input, o, record);
+    std::mutex m;
+    std::condition_variable done;
+    bool finished = false;
+    Clock::time_point requested{};
+    record.Start = Clock::now();
+    std::thread timer([&] {
+      std::unique_lock<std::mutex> lock(m);
+      if (!done.wait_until(lock, record.Start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(at)),
+            [&] { return finished; }))
+      {
+        requested = Clock::now();
+        record.AbortRequested.store(true);
+      }
+    });
+    filter->Update();
+    const Clock::time_point returned = Clock::now();
+    {
+      std::lock_guard<std::mutex> lock(m);
+      finished = true;
+    }
+    done.notify_all();
+    timer.join();
+    if (!record.AbortRequested.load())
+    {
+      std::printf("try %2d: abort at %6.2f s: the run ended first (%.2f s), status %s\n", i, at,
+        since(record.Start, returned), filter->GetStatusString());
+      continue;
+    }
+    const double latency = since(requested, returned);
+    const std::string stage = stageAt(record, since(record.Start, requested));
+    if (!latencies.count(stage))
+      order.push_back(stage);
+    latencies[stage].push_back(latency);
+    worst = std::max(worst, latency);
+
+    vtkPolyData* cage = filter->GetOutput();
+    std::string verdict = "empty";
+    if (cage->GetNumberOfPoints() > 0)
+    {
+      if (o.Check)
+      {
+        const sdfcage::exact::ExactReport report = sdfcage::exact::exactCheck(inputTriangles, toTriangles(cage), 0.0);
+        verdict = report.Encloses ? "verified cage of " + std::to_string(cage->GetNumberOfPoints()) + " vertices"
+                                  : "BROKEN cage of " + std::to_string(cage->GetNumberOfPoints()) + " vertices";
+        broken += report.Encloses ? 0 : 1;
+      }
+      else
+        verdict = "cage of " + std::to_string(cage->GetNumberOfPoints()) + " vertices (not checked)";
+    }
+    std::printf("try %2d: abort at %6.2f s (%-45s): %.3f s, status %s, output: %s\n", i, at, stage.c_str(), latency,
+      filter->GetStatusString(), verdict.c_str());
+    std::fflush(stdout);
+  }
+  std::printf("%-48s %5s %8s %8s\n", "stage", "tries", "median", "worst");
+  for (const std::string& s : order)
+    std::printf("%-48s %5zu %8.3f %8.3f\n", s.c_str(), latencies[s].size(), median(latencies[s]),
+      *std::max_element(latencies[s].begin(), latencies[s].end()));
+  std::printf("worst latency %.3f s; broken outputs: %d\n", worst, broken);
+  return broken == 0 ? 0 : 1;
+}
