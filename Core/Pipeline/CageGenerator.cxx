@@ -50,20 +50,20 @@ CageResult generateOnce(const PolygonMesh& input, const CageOptions& options, Pr
   // 1. validation
   progressStage(progress, "validating input", 0.0, 0.02);
   TriangleMesh mesh;
-  result.Defects = prepareMesh(input, mesh, options.Validation);
+  result.Defects = prepareMesh(input, mesh, options.Validation, progress);
   result.ValidationSeconds = seconds(start);
+  if (progressCancelled(progress))
+  {
+    result.State = Status::Cancelled;
+    result.Message = "cancelled";
+    return result;
+  }
   if (!result.Defects.usableAsInput())
   {
     const bool nothing =
       result.Defects.Empty && result.Defects.NonFinitePoints == 0 && result.Defects.InvalidPointIds == 0;
     result.State = nothing ? Status::EmptyInput : Status::InvalidInput;
     result.Message = result.Defects.inputErrorMessage();
-    return result;
-  }
-  if (progressCancelled(progress))
-  {
-    result.State = Status::Cancelled;
-    result.Message = "cancelled";
     return result;
   }
 

@@ -114,6 +114,9 @@ struct RunRecord
   int Events = 0;
   double LongestEventGap = 0.0; ///< seconds between consecutive progress events, the longest
   double LastEvent = 0.0;
+  std::string LastText;
+  /// per stage: the longest time between two progress events, and when it ended
+  std::map<std::string, std::pair<double, double>> StageGaps;
 };
 
 void onProgress(vtkObject* caller, unsigned long, void* clientData, void*)
@@ -128,6 +131,11 @@ void onProgress(vtkObject* caller, unsigned long, void* clientData, void*)
     if (record->Texts.empty() || record->Texts.back().second != s)
       record->Texts.emplace_back(t, s);
     record->LongestEventGap = std::max(record->LongestEventGap, t - record->LastEvent);
+    // a gap belongs to the stage it was spent in (the text before the event that ends it)
+    auto& gap = record->StageGaps[record->LastText.empty() ? std::string("start") : record->LastText];
+    if (t - record->LastEvent > gap.first)
+      gap = { t - record->LastEvent, t };
+    record->LastText = s;
     record->LastEvent = t;
     ++record->Events;
   }
@@ -247,6 +255,9 @@ int main(int argc, char* argv[])
     for (const auto& e : record.Texts)
       std::printf(" %.2f %s;", e.first, e.second.c_str());
     std::printf("\n");
+    std::printf("longest time between progress events (the filter's Abort is polled there), per stage:\n");
+    for (const auto& g : record.StageGaps)
+      std::printf("  %-45s %.3f s (until %.2f s)\n", g.first.c_str(), g.second.first, g.second.second);
   }
 
   std::map<std::string, std::vector<double>> latencies;
