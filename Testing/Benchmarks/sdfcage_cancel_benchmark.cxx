@@ -5,16 +5,18 @@
 // a flag set asynchronously (here by a timer thread) that a ProgressEvent observer turns into
 // SetAbortExecute(1). So the latency includes the time until the filter next fires a progress
 // event, and then until Core's next cancel check answers. One uninterrupted run first gives the
-// total time T; then try i (of N) requests the abort at T·(i + 0.5)/N. The stage of a try is the
-// filter's progress text at the moment of the request.
+// stages (the filter's progress texts) and how long each lasts; then, for each stage and each k of
+// K, a run requests the abort (k + 0.5)/K of that stage's duration after the stage starts (so the
+// tries follow the stages even when the machine's load changes the timings). The stage of a try
+// is the progress text at the moment of the request.
 //
 // After each cancelled run the cage output must be empty or a cage that the exact checker
 // (CGAL, Testing/Exact) finds closed, 2-manifold, self-intersection free and enclosing the input:
 // a broken one makes the program exit with 1. A benchmark (prints figures), not a timed test.
 //
-//   sdfcage_cancel_benchmark [MESH] [--tries N] [--threads T] [--vertices V] [--optimize]
-//                            [--builtin] [--no-check]
-//   (default MESH: SDFCAGE_DATA_DIR/armadillo_midsub4x.obj)
+//   sdfcage_cancel_benchmark [MESH] [--per-stage K] [--threads T] [--vertices V] [--iso C]
+//                            [--optimize] [--builtin] [--no-check]
+//   (default MESH: SDFCAGE_DATA_DIR/armadillo_midsub4x.obj, K = 3)
 #include "vtkSDFCageFilter.h"
 
 #include "MeshIO.h"
@@ -85,8 +87,8 @@ sdfcage::TriangleMesh toTriangles(vtkPolyData* pd)
   for (polys->InitTraversal(); polys->GetNextCell(ids);)
   {
     for (vtkIdType k = 1; k + 1 < ids->GetNumberOfIds(); ++k)
-      m.Triangles.push_back({ static_cast<int>(ids->GetId(0)), static_cast<int>(ids->GetId(k)),
-        static_cast<int>(ids->GetId(k + 1)) });
+      m.Triangles.push_back(
+        { static_cast<int>(ids->GetId(0)), static_cast<int>(ids->GetId(k)), static_cast<int>(ids->GetId(k + 1)) });
   }
   return m;
 }
@@ -95,9 +97,10 @@ struct Options
 {
   std::string Mesh = std::string(SDFCAGE_DATA_DIR) + "/armadillo_midsub4x.obj";
   bool Builtin = false;
-  int Tries = 20;
+  int PerStage = 3;
   int Threads = 0;
   int Vertices = -1;
+  double IsoValue = -1.0;
   bool Optimize = false;
   bool Check = true;
 };
@@ -110,6 +113,9 @@ struct RunRecord
   std::mutex Lock;
   std::vector<std::pair<double, std::string>> Texts; ///< (seconds since start, progress text)
   std::atomic<bool> AbortRequested{ false };
+  std::string TriggerStage; ///< the abort is requested Delay seconds after this text shows
+  double StageSeen = -1.0;  ///< when it showed (under Lock)
+  std::condition_variable* Wake = nullptr;
   double RequestedAt = -1.0;
   int Events = 0;
   double LongestEventGap = 0.0; ///< seconds between consecutive progress events, the longest
@@ -130,6 +136,12 @@ void onProgress(vtkObject* caller, unsigned long, void* clientData, void*)
     const std::string s = text ? text : "";
     if (record->Texts.empty() || record->Texts.back().second != s)
       record->Texts.emplace_back(t, s);
+    if (record->StageSeen < 0.0 && s == record->TriggerStage)
+    {
+      record->StageSeen = t;
+      if (record->Wake)
+        record->Wake->notify_all();
+    }
     record->LongestEventGap = std::max(record->LongestEventGap, t - record->LastEvent);
     // a gap belongs to the stage it was spent in (the text before the event that ends it)
     auto& gap = record->StageGaps[record->LastText.empty() ? std::string("start") : record->LastText];
@@ -164,6 +176,8 @@ vtkSmartPointer<vtkSDFCageFilter> makeFilter(vtkPolyData* input, const Options& 
   filter->SetNumberOfThreads(o.Threads);
   if (o.Vertices >= 0)
     filter->SetTargetNumberOfVertices(o.Vertices);
+  if (o.IsoValue > 0)
+    filter->SetIsoValue(o.IsoValue);
   filter->SetOptimize(o.Optimize ? 1 : 0);
   vtkNew<vtkCallbackCommand> observer;
   observer->SetCallback(onProgress);
@@ -195,12 +209,14 @@ int main(int argc, char* argv[])
       }
       return argv[++i];
     };
-    if (a == "--tries")
-      o.Tries = std::max(1, std::atoi(next()));
+    if (a == "--per-stage")
+      o.PerStage = std::max(1, std::atoi(next()));
     else if (a == "--threads")
       o.Threads = std::max(0, std::atoi(next()));
     else if (a == "--vertices")
       o.Vertices = std::atoi(next());
+    else if (a == "--iso")
+      o.IsoValue = std::atof(next());
     else if (a == "--optimize")
       o.Optimize = true;
     else if (a == "--builtin")
@@ -209,8 +225,8 @@ int main(int argc, char* argv[])
       o.Check = false;
     else if (a == "-h" || a == "--help")
     {
-      std::printf("usage: sdfcage_cancel_benchmark [MESH] [--tries N] [--threads T] [--vertices V] [--optimize] "
-                  "[--builtin] [--no-check]\n");
+      std::printf("usage: sdfcage_cancel_benchmark [MESH] [--per-stage K] [--threads T] [--vertices V] [--iso C] "
+                  "[--optimize] [--builtin] [--no-check]\n");
       return 0;
     }
     else if (!a.empty() && a[0] == '-')
@@ -240,8 +256,9 @@ int main(int argc, char* argv[])
   sdfcage::TriangleMesh inputTriangles;
   sdfcage::exact::fanTriangulate(mesh, inputTriangles);
 
-  // the uninterrupted run: total time and the stages' start times
+  // the uninterrupted run: total time and the stages with their durations
   double total = 0.0;
+  std::vector<std::pair<std::string, double>> stages;
   {
     RunRecord record;
     auto filter = makeFilter(input, o, record);
@@ -255,6 +272,12 @@ int main(int argc, char* argv[])
     for (const auto& e : record.Texts)
       std::printf(" %.2f %s;", e.first, e.second.c_str());
     std::printf("\n");
+    for (std::size_t k = 0; k < record.Texts.size(); ++k)
+    {
+      const double end = k + 1 < record.Texts.size() ? record.Texts[k + 1].first : total;
+      if (!record.Texts[k].second.empty())
+        stages.emplace_back(record.Texts[k].second, end - record.Texts[k].first);
+    }
     std::printf("longest time between progress events (the filter's Abort is polled there), per stage:\n");
     for (const auto& g : record.StageGaps)
       std::printf("  %-45s %.3f s (until %.2f s)\n", g.first.c_str(), g.second.first, g.second.second);
@@ -264,64 +287,73 @@ int main(int argc, char* argv[])
   std::vector<std::string> order;
   int broken = 0;
   double worst = 0.0;
-  for (int i = 0; i < o.Tries; ++i)
-  {
-    const double at = total * (i + 0.5) / o.Tries;
-    RunRecord record;
-    auto filter = makeFilter(input, o, record);
-    std::mutex m;
-    std::condition_variable done;
-    bool finished = false;
-    Clock::time_point requested{};
-    record.Start = Clock::now();
-    std::thread timer([&] {
-      std::unique_lock<std::mutex> lock(m);
-      if (!done.wait_until(lock, record.Start + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(at)),
-            [&] { return finished; }))
+  int i = 0;
+  for (const auto& stage : stages)
+    for (int k = 0; k < o.PerStage; ++k, ++i)
+    {
+      const double delay = stage.second * (k + 0.5) / o.PerStage;
+      RunRecord record;
+      auto filter = makeFilter(input, o, record);
+      std::condition_variable done;
+      bool finished = false;
+      Clock::time_point requested{};
+      record.TriggerStage = stage.first;
+      record.Wake = &done;
+      record.Start = Clock::now();
+      std::thread timer([&] {
+        std::unique_lock<std::mutex> lock(record.Lock);
+        done.wait(lock, [&] { return finished || record.StageSeen >= 0.0; });
+        if (finished)
+          return;
+        const auto at = record.Start +
+          std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(record.StageSeen + delay));
+        if (!done.wait_until(lock, at, [&] { return finished; }))
+        {
+          requested = Clock::now();
+          record.AbortRequested.store(true);
+        }
+      });
+      filter->Update();
+      const Clock::time_point returned = Clock::now();
       {
-        requested = Clock::now();
-        record.AbortRequested.store(true);
+        std::lock_guard<std::mutex> lock(record.Lock);
+        finished = true;
       }
-    });
-    filter->Update();
-    const Clock::time_point returned = Clock::now();
-    {
-      std::lock_guard<std::mutex> lock(m);
-      finished = true;
-    }
-    done.notify_all();
-    timer.join();
-    if (!record.AbortRequested.load())
-    {
-      std::printf("try %2d: abort at %6.2f s: the run ended first (%.2f s), status %s\n", i, at,
-        since(record.Start, returned), filter->GetStatusString());
-      continue;
-    }
-    const double latency = since(requested, returned);
-    const std::string stage = stageAt(record, since(record.Start, requested));
-    if (!latencies.count(stage))
-      order.push_back(stage);
-    latencies[stage].push_back(latency);
-    worst = std::max(worst, latency);
+      done.notify_all();
+      timer.join();
+      char when[160];
+      std::snprintf(when, sizeof when, "%.2f s into '%s'", delay, stage.first.c_str());
+      if (!record.AbortRequested.load())
+      {
+        std::printf("try %2d: abort %s: the run ended first (%.2f s), status %s\n", i, when,
+          since(record.Start, returned), filter->GetStatusString());
+        continue;
+      }
+      const double latency = since(requested, returned);
+      const std::string at = stageAt(record, since(record.Start, requested));
+      if (!latencies.count(at))
+        order.push_back(at);
+      latencies[at].push_back(latency);
+      worst = std::max(worst, latency);
 
-    vtkPolyData* cage = filter->GetOutput();
-    std::string verdict = "empty";
-    if (cage->GetNumberOfPoints() > 0)
-    {
-      if (o.Check)
+      vtkPolyData* cage = filter->GetOutput();
+      std::string verdict = "empty";
+      if (cage->GetNumberOfPoints() > 0)
       {
-        const sdfcage::exact::ExactReport report = sdfcage::exact::exactCheck(inputTriangles, toTriangles(cage), 0.0);
-        verdict = report.Encloses ? "verified cage of " + std::to_string(cage->GetNumberOfPoints()) + " vertices"
-                                  : "BROKEN cage of " + std::to_string(cage->GetNumberOfPoints()) + " vertices";
-        broken += report.Encloses ? 0 : 1;
+        if (o.Check)
+        {
+          const sdfcage::exact::ExactReport report = sdfcage::exact::exactCheck(inputTriangles, toTriangles(cage), 0.0);
+          verdict = report.Encloses ? "verified cage of " + std::to_string(cage->GetNumberOfPoints()) + " vertices"
+                                    : "BROKEN cage of " + std::to_string(cage->GetNumberOfPoints()) + " vertices";
+          broken += report.Encloses ? 0 : 1;
+        }
+        else
+          verdict = "cage of " + std::to_string(cage->GetNumberOfPoints()) + " vertices (not checked)";
       }
-      else
-        verdict = "cage of " + std::to_string(cage->GetNumberOfPoints()) + " vertices (not checked)";
+      std::printf("try %2d: abort %-50s (in '%s'): %.3f s, status %s, output: %s\n", i, when, at.c_str(), latency,
+        filter->GetStatusString(), verdict.c_str());
+      std::fflush(stdout);
     }
-    std::printf("try %2d: abort at %6.2f s (%-45s): %.3f s, status %s, output: %s\n", i, at, stage.c_str(), latency,
-      filter->GetStatusString(), verdict.c_str());
-    std::fflush(stdout);
-  }
   std::printf("%-48s %5s %8s %8s\n", "stage", "tries", "median", "worst");
   for (const std::string& s : order)
     std::printf("%-48s %5zu %8.3f %8.3f\n", s.c_str(), latencies[s].size(), median(latencies[s]),
