@@ -246,11 +246,17 @@ CageResult generateOnce(const PolygonMesh& input, const CageOptions& options, Pr
     result.MinimumClearanceRelative = clearance;
     result.MinimumClearance = n.lengthToInput(clearance);
     result.Simplification.Cage = TriangleMesh(); // the result keeps the input-unit copy only
-    if (result.Simplification.Cancelled || result.Optimization.State == Status::Cancelled)
+    // a cancel after the simplification (while its cage was verified) skips the optimization
+    if (result.Simplification.Cancelled || result.Optimization.State == Status::Cancelled ||
+      progressCancelled(progress))
     {
       result.State = Status::Cancelled;
-      result.Message = result.Simplification.Cancelled ? "cancelled during simplification; the cage so far is valid"
-                                                       : "cancelled during optimization; the cage so far is valid";
+      if (result.Simplification.Cancelled)
+        result.Message = "cancelled during simplification; the cage so far is valid";
+      else if (result.Optimization.State == Status::Cancelled)
+        result.Message = "cancelled during optimization; the cage so far is valid";
+      else
+        result.Message = "cancelled after the simplification; its cage is valid";
       result.TotalSeconds = seconds(start);
       return result;
     }
