@@ -1,8 +1,8 @@
 #!/bin/bash
 # Fuzzes the readers and Core with libFuzzer (clang, AddressSanitizer + UndefinedBehaviorSanitizer,
-# LeakSanitizer on): configures Testing/Fuzz into build-fuzz/ with clang, builds its four
-# harnesses, replays every kept regression input (Testing/Fuzz/regressions/<harness>/), then
-# runs each harness for FUZZ_SECONDS (default 45) from its seed corpus
+# LeakSanitizer on): configures Testing/Fuzz into build-fuzz/ with clang (.ci/sanitized-build.sh),
+# builds its four harnesses, replays every kept regression input
+# (Testing/Fuzz/regressions/<harness>/), then runs each harness for FUZZ_SECONDS (default 45) from its seed corpus
 # (Testing/Fuzz/corpus/<harness>/; the corpus grown by the run stays in build-fuzz/). A crash, a
 # sanitizer report, an input slower than 10 s or a process over 2 GB fails; the input is left in
 # build-fuzz/artifacts/ (keep it as a regression case once fixed).
@@ -11,19 +11,16 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${FUZZ_SECONDS:-45}"
-flags="-O1 -g -fno-omit-frame-pointer -fsanitize=fuzzer-no-link,address,undefined -fno-sanitize-recover=undefined"
-flags+=" -fsanitize-ignorelist=$PWD/Testing/Fuzz/ubsan_ignore.txt"
-
-CC=clang CXX=clang++ cmake -S Testing/Fuzz -B build-fuzz -G Ninja -DCMAKE_BUILD_TYPE=None \
-  "-DCMAKE_C_FLAGS=$flags" "-DCMAKE_CXX_FLAGS=$flags"
-cmake --build build-fuzz -j2
+harnesses=(fuzz_mesh_parsers fuzz_off_reader fuzz_cli_read fuzz_core_pipeline)
+# the sanitized build of build-fuzz/ (configured there, shared with .ci/asan.sh)
+bash .ci/sanitized-build.sh "${harnesses[@]}"
 
 mkdir -p build-fuzz/artifacts
 export ASAN_OPTIONS="detect_leaks=1:allocator_may_return_null=1"
 export UBSAN_OPTIONS="print_stacktrace=1"
 export LSAN_OPTIONS="suppressions=$PWD/Testing/Fuzz/lsan.supp:print_suppressions=0"
 status=0
-for harness in fuzz_mesh_parsers fuzz_off_reader fuzz_cli_read fuzz_core_pipeline; do
+for harness in "${harnesses[@]}"; do
   exe="build-fuzz/$harness"
   options=(-timeout=10 -rss_limit_mb=2048 -malloc_limit_mb=2048 "-artifact_prefix=build-fuzz/artifacts/$harness-")
   regressions="Testing/Fuzz/regressions/$harness"

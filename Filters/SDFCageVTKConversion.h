@@ -11,6 +11,8 @@
 #include "Common/Progress.h"
 #include "Pipeline/Results.h"
 
+#include <algorithm>
+#include <chrono>
 #include <string>
 #include <thread>
 #include <vector>
@@ -25,14 +27,23 @@ namespace sdfcage_vtk
 // Core may call report()/pollCancel() from worker threads; VTK objects are only touched from the
 // thread that runs RequestData (the one that constructed this object). Cancellation still reaches
 // the workers: Progress latches the flag in an atomic once pollCancel() has returned true.
+//
+// A progress event fires at every new stage, every 1% and, whatever the progress, at least every
+// EventInterval seconds while Core runs (from its progress reports or its cancel checks): ParaView's
+// Cancel and the sdfcage program's Ctrl-C set AbortExecute from a ProgressEvent observer, so a
+// stage that reports little progress would otherwise not be cancelled before it ends.
 class FilterProgress final : public sdfcage::Progress
 {
 public:
   explicit FilterProgress(vtkAlgorithm* filter)
     : Filter(filter)
     , Owner(std::this_thread::get_id())
+    , LastEvent(std::chrono::steady_clock::now())
   {
   }
+
+  /// Seconds between progress events at the most, while Core reports or checks for a cancel.
+  static constexpr double EventInterval = 0.05;
 
 protected:
   void report(double overall, const std::string& stage) override
@@ -42,9 +53,10 @@ protected:
       return;
     }
     // Throttle: a new stage always shows; inside a stage, report every 1% at most (each
-    // UpdateProgress fires observers, which in ParaView repaint a progress bar).
+    // UpdateProgress fires observers, which in ParaView repaint a progress bar), or when the
+    // last event is EventInterval old.
     const bool newStage = stage != this->LastStage;
-    if (!newStage && overall < this->LastReported + 0.01)
+    if (!newStage && overall < this->LastReported + 0.01 && !this->eventDue())
     {
       return;
     }
@@ -54,19 +66,39 @@ protected:
       this->Filter->SetProgressText(stage.c_str());
     }
     this->LastReported = overall;
-    this->Filter->UpdateProgress(overall);
+    this->fire(overall);
   }
 
   bool pollCancel() override
   {
-    return std::this_thread::get_id() == this->Owner && this->Filter->GetAbortExecute() != 0;
+    if (std::this_thread::get_id() != this->Owner)
+    {
+      return false;
+    }
+    if (this->eventDue())
+    {
+      this->fire(std::max(this->LastReported, this->overall()));
+    }
+    return this->Filter->GetAbortExecute() != 0;
   }
 
 private:
+  bool eventDue() const
+  {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - this->LastEvent).count() >=
+      EventInterval;
+  }
+  void fire(double overall)
+  {
+    this->LastEvent = std::chrono::steady_clock::now();
+    this->Filter->UpdateProgress(std::min(1.0, std::max(0.0, overall)));
+  }
+
   vtkAlgorithm* Filter;
   std::thread::id Owner;
   std::string LastStage;
   double LastReported = -1.0;
+  std::chrono::steady_clock::time_point LastEvent;
 };
 
 /// The cells of a vtkPolyData as Core's polygon mesh (strips split, verts/lines kept as 1-/2-

@@ -885,11 +885,22 @@ ActivePoints computeActivePoints(const TriangleMesh& unitInput, const ActivePoin
 
   // sampling: samples half a spacing apart along the surface
   const EdgeGraph graph(S);
+  if (progressCancelled(progress))
+  {
+    result.Cancelled = true;
+    result.Seconds = seconds(t0);
+    return result;
+  }
   const double separation = 0.5 * spacing;
   const std::vector<char> referenced = referencedPoints(S);
   const std::vector<int> samples = sampleSurface(graph, referenced, separation);
   result.NumberOfSamples = samples.size();
-  progressUpdate(progress, 0.1);
+  if (progressUpdate(progress, 0.1))
+  {
+    result.Cancelled = true;
+    result.Seconds = seconds(t0);
+    return result;
+  }
 
   // candidate search within r, geodesic test against l, marking of the active samples
   ActiveSampleDetection detection(S, graph, samples, options.Radius, options.GeodesicThreshold, progress);

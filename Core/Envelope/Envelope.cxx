@@ -488,6 +488,12 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
     result.InputComponents = triangleComponents(unitInput, comp);
     result.InputGenus = result.InputClosed ? genus(unitInput) : -1;
   }
+  if (progressCancelled(progress))
+  {
+    result.State = Status::Cancelled;
+    result.Message = "cancelled";
+    return result;
+  }
   ActivePoints active;
   const ActivePoints* amplification = nullptr;
   std::unique_ptr<TriangleTree> surfaceTree;
@@ -574,6 +580,10 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
       auto t0 = std::chrono::steady_clock::now();
       int pockets = 0;
       TriangleMesh envelope = outerBoundary(surface, pockets);
+      if (progressCancelled(progress))
+      {
+        return false; // computeIsosurface reports the cancel
+      }
       if (options.VertexBudget > 0)
       {
         // too many parts and handles for the target: not worth verifying (a wider one follows)

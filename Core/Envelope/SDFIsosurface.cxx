@@ -121,7 +121,7 @@ std::vector<int> mortonOrder(const std::vector<openvdb::Vec3s>& points, const st
 /// number of voxels changed by more than 1e-3 relative.
 /// `noAdapt` (a topology copy of grid's tree) keeps on only the voxels where phi > 1.01.
 std::size_t amplify(openvdb::FloatGrid& grid, const openvdb::Int32Grid& index, const std::vector<int>& order,
-  const ActivePoints& amp, double voxelSize, float maxValue, openvdb::BoolTree& noAdapt)
+  const ActivePoints& amp, double voxelSize, float maxValue, openvdb::BoolTree& noAdapt, Progress* progress)
 {
   openvdb::tree::LeafManager<openvdb::FloatTree> leaves(grid.tree());
   std::atomic<std::size_t> changed{ 0 };
@@ -131,6 +131,10 @@ std::size_t amplify(openvdb::FloatGrid& grid, const openvdb::Int32Grid& index, c
     std::size_t local = 0;
     for (auto leaf = range.begin(); leaf; ++leaf)
     {
+      if (progressCancelled(progress))
+      {
+        return; // the caller reports the cancel
+      }
       openvdb::BoolTree::LeafNodeType* maskLeaf = noAdapt.probeLeaf(leaf->origin());
       for (auto it = leaf->beginValueOn(); it; ++it)
       {
@@ -605,12 +609,17 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
     // phi >= 1, so only where xi <= iso (plus a voxel for the interpolation).
     const auto ta = std::chrono::steady_clock::now();
     noAdapt.reset(new openvdb::BoolTree(grid->tree(), false, openvdb::TopologyCopy()));
-    out.AmplifiedVoxels = amplify(
-      *grid, *closestTriangle, order, *amplification, voxelSize, static_cast<float>(iso + 2.0 * voxelSize), *noAdapt);
+    out.AmplifiedVoxels = amplify(*grid, *closestTriangle, order, *amplification, voxelSize,
+      static_cast<float>(iso + 2.0 * voxelSize), *noAdapt, progress);
     openvdb::tools::dilateActiveValues(*noAdapt, 1);
     closestTriangle.reset();
     out.AmplificationSeconds = seconds(ta);
     out.DistanceFieldSeconds += out.AmplificationSeconds;
+  }
+  if (progressCancelled(progress))
+  {
+    out.Cancelled = true;
+    return out;
   }
 
   // the extractions and the display field only: the judge's time is its caller's to count
@@ -631,6 +640,11 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
       catch (const std::exception& e)
       {
         out.Error = std::string("OpenVDB could not extract the isosurface: ") + e.what();
+        return out;
+      }
+      if (progressCancelled(progress))
+      {
+        out.Cancelled = true;
         return out;
       }
       if (!judge)

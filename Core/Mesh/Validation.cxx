@@ -1,5 +1,6 @@
 #include "Mesh/Validation.h"
 
+#include "Common/Progress.h"
 #include "Spatial/Geometry.h"
 
 #include <algorithm>
@@ -472,10 +473,18 @@ MeshDefects checkTriangleMesh(const TriangleMesh& mesh)
   return d;
 }
 
-MeshDefects prepareMesh(const PolygonMesh& input, TriangleMesh& output, const ValidationOptions& options)
+MeshDefects prepareMesh(
+  const PolygonMesh& input, TriangleMesh& output, const ValidationOptions& options, Progress* progress)
 {
   MeshDefects d;
   output = TriangleMesh();
+  // a cancel answers between the steps (each a fraction of a second on a million triangles)
+  const auto cancelled = [&]() {
+    if (!progressCancelled(progress))
+      return false;
+    output = TriangleMesh();
+    return true;
+  };
   const std::int64_t np = static_cast<std::int64_t>(input.Points.size());
   const std::size_t nc = input.numberOfCells();
 
@@ -530,6 +539,8 @@ MeshDefects prepareMesh(const PolygonMesh& input, TriangleMesh& output, const Va
     return d; // geometry cannot be trusted further
   }
 
+  if (cancelled())
+    return d;
   // 2. coincident points merged (split seams, STL facet corners, duplicated scan points) where
   // one of them is on a boundary edge of the cells as given: a split seam is closed again, while
   // two distinct points of a closed surface that happen to coincide stay apart (merging them
@@ -554,6 +565,8 @@ MeshDefects prepareMesh(const PolygonMesh& input, TriangleMesh& output, const Va
           edges.push_back(std::min(u, v) << 32 | std::max(u, v));
       }
     }
+    if (cancelled())
+      return d;
     std::sort(edges.begin(), edges.end());
     std::vector<char> onBoundary(np, 0);
     bool any = false;
@@ -586,9 +599,13 @@ MeshDefects prepareMesh(const PolygonMesh& input, TriangleMesh& output, const Va
       }
       i = j;
     }
+    if (cancelled())
+      return d;
     d.MergedPoints =
       mergeCoincidentPoints(input.Points, referenced, onBoundary, lo, any ? d.MergeTolerance : -1.0, rep);
   }
+  if (cancelled())
+    return d;
   auto id = [&](std::int64_t k) { return static_cast<int>(rep[input.Connectivity[k]]); };
 
   // 3. cells -> triangles: convex planar polygons by a fan (as before), others by ear clipping
@@ -642,6 +659,8 @@ MeshDefects prepareMesh(const PolygonMesh& input, TriangleMesh& output, const Va
     }
   }
 
+  if (cancelled())
+    return d;
   // 4. degenerate (area relative to the squared bounding-box diagonal) and duplicated triangles
   // dropped
   {
@@ -668,6 +687,8 @@ MeshDefects prepareMesh(const PolygonMesh& input, TriangleMesh& output, const Va
       std::sort(k.begin(), k.end());
       sorted[f] = { k, static_cast<int>(f) };
     }
+    if (cancelled())
+      return d;
     std::sort(sorted.begin(), sorted.end());
     std::vector<char> duplicate(kept.size(), 0);
     for (std::size_t i = 1; i < sorted.size(); ++i)
@@ -687,6 +708,8 @@ MeshDefects prepareMesh(const PolygonMesh& input, TriangleMesh& output, const Va
       }
     }
   }
+  if (cancelled())
+    return d;
   d.Empty = output.Triangles.empty();
   if (d.Empty)
   {
@@ -696,8 +719,12 @@ MeshDefects prepareMesh(const PolygonMesh& input, TriangleMesh& output, const Va
   removeUnreferencedPoints(output);
   d.UnreferencedPoints = static_cast<std::int64_t>(input.Points.size() - output.Points.size()) - d.MergedPoints;
 
+  if (cancelled())
+    return d;
   // 3. topology
   checkTopology(output, d);
+  if (cancelled())
+    return d;
   std::vector<int> comp;
   d.Components = triangleComponents(output, comp);
   if (!d.closedManifold())
@@ -705,6 +732,8 @@ MeshDefects prepareMesh(const PolygonMesh& input, TriangleMesh& output, const Va
     return d; // no orientation to fix, no genus: the winding number decides the inside
   }
 
+  if (cancelled())
+    return d;
   // 4. orientation per component: a component with negative volume faces inward, unless it is a
   // cavity inside another component (then inward is right).
   std::vector<double> volume(d.Components, 0.0);
@@ -766,6 +795,8 @@ MeshDefects prepareMesh(const PolygonMesh& input, TriangleMesh& output, const Va
       }
     }
   }
+  if (cancelled())
+    return d;
   d.Genus = genus(output);
   return d;
 }

@@ -10,6 +10,7 @@
 
 namespace sdfcage
 {
+class Progress;
 
 /// Counts of everything validation found and repaired.
 ///
@@ -78,8 +79,10 @@ struct ValidationOptions
 /// drops degenerate and duplicated triangles and unreferenced points, ignores vertex/line cells,
 /// measures closedness, manifoldness and orientation consistency, and flips a closed
 /// inward-oriented mesh. `output` is valid when the returned defects are usableAsInput().
-MeshDefects prepareMesh(
-  const PolygonMesh& input, TriangleMesh& output, const ValidationOptions& options = ValidationOptions());
+/// With `progress`, cancel checks between its steps: once cancelled it returns at the next one
+/// with `output` empty (the caller tells a cancel by progress->cancelled(), not by the defects).
+MeshDefects prepareMesh(const PolygonMesh& input, TriangleMesh& output,
+  const ValidationOptions& options = ValidationOptions(), Progress* progress = nullptr);
 
 /// The same checks on a triangle mesh, without conversion or flipping (used to check envelopes
 /// and cages). Orientation is reported through InconsistentEdges only.

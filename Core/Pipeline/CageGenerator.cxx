@@ -22,6 +22,23 @@ double seconds(std::chrono::steady_clock::time_point t0)
 {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
+
+/// Cancels itself `seconds` after its construction: the time budget of the verification of a cage
+/// cut short by a cancel (see below).
+class Deadline final : public Progress
+{
+public:
+  explicit Deadline(double seconds)
+    : End(std::chrono::steady_clock::now() + std::chrono::microseconds(static_cast<long long>(seconds * 1e6)))
+  {
+  }
+
+protected:
+  bool pollCancel() override { return std::chrono::steady_clock::now() >= this->End; }
+
+private:
+  std::chrono::steady_clock::time_point End;
+};
 } // namespace
 
 ScalarImage imageToInput(ScalarImage image, const Normalization& n)
@@ -50,20 +67,20 @@ CageResult generateOnce(const PolygonMesh& input, const CageOptions& options, Pr
   // 1. validation
   progressStage(progress, "validating input", 0.0, 0.02);
   TriangleMesh mesh;
-  result.Defects = prepareMesh(input, mesh, options.Validation);
+  result.Defects = prepareMesh(input, mesh, options.Validation, progress);
   result.ValidationSeconds = seconds(start);
+  if (progressCancelled(progress))
+  {
+    result.State = Status::Cancelled;
+    result.Message = "cancelled";
+    return result;
+  }
   if (!result.Defects.usableAsInput())
   {
     const bool nothing =
       result.Defects.Empty && result.Defects.NonFinitePoints == 0 && result.Defects.InvalidPointIds == 0;
     result.State = nothing ? Status::EmptyInput : Status::InvalidInput;
     result.Message = result.Defects.inputErrorMessage();
-    return result;
-  }
-  if (progressCancelled(progress))
-  {
-    result.State = Status::Cancelled;
-    result.Message = "cancelled";
     return result;
   }
 
@@ -175,15 +192,26 @@ CageResult generateOnce(const PolygonMesh& input, const CageOptions& options, Pr
     result.TargetReached = result.Simplification.TargetReached;
     result.StopReason = result.Simplification.StopReason;
     // independent re-verification of the final cage (exact distances, winding numbers). It runs
-    // even after a cancel: the partial cage is valid and usable.
+    // even after a cancel: the partial cage is valid and usable. But a cancel must answer at
+    // once, and a cage cut short early is large: then (over 20,000 vertices: some 50 ms to verify
+    // on one core) the verification gets a short time budget, and no cage is output if it runs out.
     progressStage(progress, "verifying cage", 0.95, options.Optimize ? 0.96 : 1.0);
     const auto t1 = std::chrono::steady_clock::now();
     std::vector<double> dist;
     std::string why;
     double clearance = 0.0;
-    const bool ok =
-      verifyEnclosure(unit, result.Simplification.Cage, so.Clearance, clearance, why, &dist, nullptr, true, &tree);
+    Deadline budget(0.2);
+    const bool ok = verifyEnclosure(unit, result.Simplification.Cage, so.Clearance, clearance, why, &dist,
+      result.Simplification.Cancelled && result.Simplification.Cage.Points.size() > 20000 ? &budget : nullptr, true,
+      &tree);
     result.CageVerificationSeconds = seconds(t1);
+    if (!ok && result.Simplification.Cancelled && budget.cancelled())
+    {
+      result.State = Status::Cancelled;
+      result.Message = "cancelled during simplification; the cage so far was too large to verify at once: no cage";
+      result.TotalSeconds = seconds(start);
+      return result;
+    }
     if (!ok)
     {
       result.State = Status::VerificationFailed;
@@ -218,11 +246,17 @@ CageResult generateOnce(const PolygonMesh& input, const CageOptions& options, Pr
     result.MinimumClearanceRelative = clearance;
     result.MinimumClearance = n.lengthToInput(clearance);
     result.Simplification.Cage = TriangleMesh(); // the result keeps the input-unit copy only
-    if (result.Simplification.Cancelled || result.Optimization.State == Status::Cancelled)
+    // a cancel after the simplification (while its cage was verified) skips the optimization
+    if (result.Simplification.Cancelled || result.Optimization.State == Status::Cancelled ||
+      progressCancelled(progress))
     {
       result.State = Status::Cancelled;
-      result.Message = result.Simplification.Cancelled ? "cancelled during simplification; the cage so far is valid"
-                                                       : "cancelled during optimization; the cage so far is valid";
+      if (result.Simplification.Cancelled)
+        result.Message = "cancelled during simplification; the cage so far is valid";
+      else if (result.Optimization.State == Status::Cancelled)
+        result.Message = "cancelled during optimization; the cage so far is valid";
+      else
+        result.Message = "cancelled after the simplification; its cage is valid";
       result.TotalSeconds = seconds(start);
       return result;
     }

@@ -1,0 +1,64 @@
+#!/bin/bash
+# Sanitizer tests: Core's unit tests and the filters' tests, built with clang, AddressSanitizer +
+# UndefinedBehaviorSanitizer (LeakSanitizer on) into build-fuzz/ (.ci/sanitized-build.sh: the
+# fuzzers' build, so Core is compiled once for both), run on the suite's fast part (below). Any
+# sanitizer report, crash or failed test fails.
+#   bash .ci/asan.sh                      build and run the fast part (called by .ci/test.sh)
+#   SANITIZER_TESTS=all bash .ci/asan.sh  every test of those executables
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash .ci/sanitized-build.sh SDFCageCoreTests SDFCageQualityTests SDFCageFiltersTests SDFCageQualityFilterTests
+
+export ASAN_OPTIONS="detect_leaks=1:strict_string_checks=1:detect_stack_use_after_return=1"
+export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+export LSAN_OPTIONS="suppressions=$PWD/Testing/Fuzz/lsan.supp:print_suppressions=0"
+data="$PWD/../shared/data"
+scratch="build-fuzz/Temporary"
+mkdir -p "$scratch"
+
+# The slow part (5-50 s each in the ordinary build, 10x that here) is left to the ordinary build's
+# ctest run; so are the filters' tests that run whole pipelines (their Core code is covered by
+# Core's tests). The filters' tests that stay: error paths, parameters, the OFF reader and writer,
+# the abort (cancel) paths, the quality filter on hand-made cages. SANITIZER_TESTS=all runs all.
+filter_cases=(NoSurface EmptyInput Abort Parameters OFFRoundTrip OFFVariants OFFMalformed ActivePointsErrors)
+quality_cases=(QualityGoodCube QualityBrokenCages QualityAbort QualityMixedCells)
+slow_core=(AnyMeshRepairs.ForcedRulesAreHonoured AnyMeshWidening.OffKeepsTheIsovalueOnReportsTheWiderEnvelope
+  Simplification.ExactVertexCountsAndGuarantees ShapeAwareEnvelope.PlatesStaySeparateAndEnclosed
+  Simplification.DeterministicAcrossThreadCounts ActivePointAnalysis.InputCoordinatesAndFields
+  Simplification.CoarseTargetsAreReached GenerateCage.OtherVertexCounts Cancel.FromReportLateInTheRunGivesCancelled
+  CageErrors.OpenInputIsCagedAndReported Simplification.PlainQEMFailsWhereConstrainedPasses)
+status=0
+run() {
+  local name="$1"
+  shift
+  local start=$SECONDS code=0
+  "$@" >"build-fuzz/$name.log" 2>&1 || code=$?
+  if [ $code = 125 ]; then
+    echo "skipped: $name"
+  elif [ $code = 0 ] && ! grep -q -E "ERROR:|runtime error:" "build-fuzz/$name.log"; then
+    # (VTK's errors fail the filters' tests as in ctest: FAIL_REGULAR_EXPRESSION "ERROR:")
+    echo "passed: $name ($((SECONDS - start)) s)"
+  else
+    echo "FAILED: $name (exit code $code, $((SECONDS - start)) s); the end of build-fuzz/$name.log:"
+    tail -n 60 "build-fuzz/$name.log"
+    status=1
+  fi
+}
+if [ "${SANITIZER_TESTS:-fast}" = all ]; then
+  slow_core=(None)
+  filter_cases=(Sphere BuiltinShape OpenInput NoSurface EmptyInput Abort DistanceField Parameters OptimizeFilter
+    OFFRoundTrip OFFVariants OFFMalformed ActivePointsBuiltin ActivePointsErrors)
+  quality_cases=(QualityGoodCube QualityBrokenCages QualityOfSDFCage QualityAbort QualityMixedCells)
+fi
+run core build-fuzz/SDFCageCoreTests "--gtest_filter=-$(
+  IFS=:
+  echo "${slow_core[*]}"
+)"
+run quality build-fuzz/SDFCageQualityTests
+for c in "${filter_cases[@]}"; do
+  run "filters.$c" build-fuzz/SDFCageFiltersTests "$c" "$scratch" "$data"
+done
+for c in "${quality_cases[@]}"; do
+  run "filters.$c" build-fuzz/SDFCageQualityFilterTests "$c" "$scratch"
+done
+exit $status
