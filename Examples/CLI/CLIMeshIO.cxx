@@ -31,6 +31,7 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iomanip>
 #include <sstream>
 
 namespace fs = std::filesystem;
@@ -133,6 +134,12 @@ bool checkLegacyCounts(const std::string& bytes, std::string& why)
     std::string keyword;
     in >> keyword;
     const double perValue = binary ? 1.0 : 2.0;
+    // a declared count as text (no conversion to an integer type: a header may declare 1e34)
+    auto count = [](double v) {
+      std::ostringstream c;
+      c << std::fixed << std::setprecision(0) << v;
+      return c.str();
+    };
     auto tooLarge = [&](double values, const std::string& what) {
       if (values * perValue <= size + 1.0)
       {
@@ -152,7 +159,7 @@ bool checkLegacyCounts(const std::string& bytes, std::string& why)
         why = "line " + std::to_string(lineNumber) + ": " + keyword + " needs a non-negative count";
         return false;
       }
-      if (tooLarge(keyword == "POINTS" ? 3 * n : n, std::to_string(static_cast<long long>(n)) + " " +
+      if (tooLarge(keyword == "POINTS" ? 3 * n : n, count(n) + " " +
               (keyword == "POINTS" ? "points" : "data tuples")))
       {
         return false;
@@ -166,8 +173,8 @@ bool checkLegacyCounts(const std::string& bytes, std::string& why)
         why = "line " + std::to_string(lineNumber) + ": " + keyword + " needs two non-negative counts";
         return false;
       }
-      if (tooLarge(std::max(n, values), std::to_string(static_cast<long long>(n)) + " cells of " +
-              std::to_string(static_cast<long long>(values)) + " values"))
+      if (tooLarge(std::max(n, values), count(n) + " cells of " +
+              count(values) + " values"))
       {
         return false;
       }
@@ -183,7 +190,7 @@ bool checkLegacyCounts(const std::string& bytes, std::string& why)
           type == "long" || type == "unsigned_long" || type == "vtktypeint64" || type == "vtktypeuint64" ||
           type == "bit" || type == "string"))
       {
-        if (tooLarge(components * tuples, "an array of " + std::to_string(static_cast<long long>(tuples)) +
+        if (tooLarge(components * tuples, "an array of " + count(tuples) +
                 " tuples"))
         {
           return false;
