@@ -95,7 +95,27 @@ class Ranks:
 
 
 # --- the meshes --------------------------------------------------------------------------------------
-def list_meshes(inputs, recursive, order="size"):
+def read_costs(path):
+    """Per-mesh times (seconds) from an earlier run's summary.csv, keyed by file path and by name."""
+    costs = {}
+    if not path:
+        return costs
+    base = os.path.dirname(os.path.abspath(path))
+    with open(path, newline="") as f:
+        for row in csv.DictReader(f):
+            try:
+                t = float(row.get("time_s") or "")
+            except ValueError:
+                continue
+            if row.get("mesh"):
+                costs[row["mesh"]] = t
+            if row.get("file"):
+                costs[os.path.abspath(row["file"])] = t
+                costs[os.path.abspath(os.path.join(base, row["file"]))] = t
+    return costs
+
+
+def list_meshes(inputs, recursive, order="size", costs=None):
     paths = []
     for item in inputs:
         if os.path.isdir(item):
@@ -128,6 +148,14 @@ def list_meshes(inputs, recursive, order="size"):
     size = lambda p: os.path.getsize(p) if os.path.exists(p) else 0  # noqa: E731
     if order == "list":  # as given (e.g. the slowest of an earlier run first)
         return [(names[p], p) for p in meshes]
+    costs = costs or {}
+    if costs:
+        # slowest first by an earlier run's times; meshes it does not know go before them, largest file
+        # first (a new mesh may be slow: starting it late would leave it alone at the end)
+        def cost_key(p):
+            t = costs.get(p, costs.get(names[p]))
+            return (0, -size(p), p) if t is None else (1, -t, p)
+        return [(names[p], p) for p in sorted(meshes, key=cost_key)]
     # largest first (the file size stands for the work: reading it costs nothing)
     return [(names[p], p) for p in sorted(meshes, key=lambda p: (-size(p), p))]
 
@@ -184,6 +212,12 @@ def cage_one(name, path, args, rank):
             timed_out = True
         CURRENT_CHILD[:] = []
     seconds = time.time() - start
+    if not timed_out and code in (130, 143, -signal.SIGINT, -signal.SIGTERM, -signal.SIGHUP):
+        # the child was interrupted with the batch (Ctrl-C, a scheduler's SIGTERM to the job's process
+        # group): no record, so that a resumed batch does this mesh again
+        print("[rank %d] %-28s interrupted after %.2f s: not recorded, redone on resume" % (rank, name, seconds),
+              flush=True)
+        return None
     report = {}
     try:
         with open(report_path) as f:
@@ -364,6 +398,9 @@ def parse(argv):
     ap.add_argument("--recursive", action="store_true", help="also the meshes in sub-folders")
     ap.add_argument("--order", choices=("size", "list"), default="size",
                     help="hand-out order: largest file first (default) or as listed")
+    ap.add_argument("--costs", default="",
+                    help="an earlier run's summary.csv: hand out the slowest meshes of that run first "
+                         "(a small file can be a slow mesh); meshes it lacks go first, largest first")
     ap.add_argument("--retry-failed", action="store_true", help="redo the meshes whose verdict was not verified")
     ap.add_argument("--summary-only", action="store_true", help="only rebuild the summary and cages.vtpc")
     ap.add_argument("--sdfcage", default="", help="the sdfcage program (default: found beside the plugin or on PATH)")
@@ -390,7 +427,13 @@ def main(argv):
             ok = 0
     if not ranks.broadcast_int(ok):
         return 2
-    meshes = list_meshes(args.inputs, args.recursive, args.order)  # every rank lists the same, in the same order
+    try:
+        costs = read_costs(args.costs) if args.order == "size" else {}
+    except (OSError, csv.Error) as e:
+        if ranks.rank == 0:
+            print("sdfcage_batch: cannot read --costs %s: %s" % (args.costs, e), file=sys.stderr)
+        return 2
+    meshes = list_meshes(args.inputs, args.recursive, args.order, costs)  # every rank lists the same, in the same order
     todo = [] if args.summary_only else [m for m in meshes if not finished(args.output, m[0], args.retry_failed)]
     if ranks.rank == 0:
         print("sdfcage_batch: %d meshes, %d to do (%d already done), %d rank(s), %d thread(s) per mesh, program %s"

@@ -158,11 +158,25 @@ chk.check(all(coll.GetPartition(i, 0).GetNumberOfPoints() == N for i in range(co
 # --- 2. resume after a real interruption ---------------------------------------------------------
 out2 = os.path.join(a.scratch, "batch_interrupted")
 shutil.rmtree(out2, ignore_errors=True)
-print("run (to interrupt):", " ".join(batch_cmd(out2)), flush=True)
-proc = subprocess.Popen(batch_cmd(out2), stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
+# the interruption must come while meshes are left: on an idle machine the whole batch takes about
+# a second, faster than any polling. So the run to interrupt calls sdfcage through a wrapper that
+# holds the largest mesh (the first handed out) for a minute the first time it is asked for it.
+held = os.path.join(a.scratch, "batch_held_once")
+if os.path.exists(held):
+    os.remove(held)
+wrapper = os.path.join(a.scratch, "sdfcage_slow_once.sh")
+largest = max(sizes, key=lambda n: sizes[n])
+with open(wrapper, "w") as f:
+    f.write("#!/bin/sh\ncase \"$*\" in *%s.off*) [ -e '%s' ] || { touch '%s'; sleep 60; } ;; esac\nexec '%s' \"$@\"\n"
+            % (largest, held, held, a.sdfcage))
+os.chmod(wrapper, 0o755)
+cmd2 = batch_cmd(out2)
+cmd2[cmd2.index("--sdfcage") + 1] = wrapper
+print("run (to interrupt):", " ".join(cmd2), flush=True)
+proc = subprocess.Popen(cmd2, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                         start_new_session=True)
 deadline = time.time() + 300
-while time.time() < deadline and proc.poll() is None and len(records(out2)) < 1:
+while time.time() < deadline and proc.poll() is None and len(records(out2)) < len(sizes) - 1:
     time.sleep(0.1)
 os.killpg(proc.pid, signal.SIGTERM)
 try:
@@ -187,4 +201,28 @@ chk.check(all(rows2[n]["verdict"] == "verified" for n in good) and rows2["bad"][
 p = run(batch_cmd(out2, ranks=2))
 chk.check("0 to do (%d already done)" % len(sizes) in p.stdout and records(out2) == after,
           "a finished batch run again does nothing")
+
+# --- 4. hand-out by an earlier run's times (--costs): the slowest of that run first ------------
+# a made-up earlier summary that calls the smallest file the slowest, and knows nothing of "blob":
+# on one rank the meshes start in the order blob (unknown: first), then by falling cost
+costs_csv = os.path.join(a.scratch, "batch_costs.csv")
+by_size = sorted((n for n in good if n != "blob"), key=lambda n: sizes[n])
+with open(costs_csv, "w") as f:
+    f.write("mesh,file,time_s\n")
+    for i, n in enumerate(by_size):
+        f.write("%s,%s,%d\n" % (n, os.path.join(folder, n + ".off"), 100 - i))
+out3 = os.path.join(a.scratch, "batch_out_costs")
+shutil.rmtree(out3, ignore_errors=True)
+p = run(batch_cmd(out3, ranks=1) + ["--costs", costs_csv])
+chk.check(p.returncode == 0, "the batch with --costs ends with exit code 0")
+starts3 = {}
+for n in sizes:
+    try:
+        with open(os.path.join(out3, "reports", n + ".batch.json")) as f:
+            starts3[n] = json.load(f)["started"]
+    except (OSError, ValueError, KeyError):
+        pass
+order3 = [n for n in sorted(starts3, key=lambda n: starts3[n]) if n != "bad"]
+chk.check(order3 == ["blob"] + by_size, "--costs: unknown mesh first, then the slowest of the earlier run (%s)"
+          % order3)
 chk.finish()
