@@ -16,17 +16,15 @@ machine without a display run it under `xvfb-run -a`.
     xvfb-run -a pvpython Examples/ParaView/cage_deformation.py ../shared/data/armadillo.obj \\
         --screenshot docs/deformation.png
 """
-import argparse
 import builtins
 import os
 import sys
 
-from paraview.simple import *  # noqa: F401,F403
-from paraview import servermanager
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from paraview.simple import *  # noqa: E402,F401,F403
+import sdfcage_example as ex  # noqa: E402
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-DEFAULT_PLUGIN = os.path.join(HERE, "..", "..", "build", "lib", "paraview-5.11", "plugins",
-                              "SDFCage", "SDFCage.so")
+field = ex.field
 
 # The Programmable Filter's script: bends the cage's points (runs where the data is).
 BEND_SCRIPT = """
@@ -55,39 +53,21 @@ out.SetPoints(points)
 """
 
 
-def field(data, name):
-    array = data.GetFieldData().GetAbstractArray(name)
-    return None if array is None else array.GetValue(0)
-
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("mesh", nargs="?", help="closed surface mesh (default: a stretched sphere)")
-    parser.add_argument("--plugin", default=os.environ.get("SDFCAGE_PLUGIN", DEFAULT_PLUGIN),
-                        help="path of SDFCage.so (default: the build tree's, or $SDFCAGE_PLUGIN)")
+    parser = ex.parser(__doc__, "closed surface mesh (default: a stretched sphere)", "cage_deformation.png")
     parser.add_argument("-n", "--vertices", type=int, default=500, help="cage vertices (500)")
     parser.add_argument("--angle", type=float, default=70.0, help="bend angle in degrees (70)")
-    parser.add_argument("--screenshot", default="cage_deformation.png", help="PNG to write")
     args = parser.parse_args()
 
-    if not os.path.isfile(args.plugin):
-        print("error: plugin not found: %s (build the project or pass --plugin)" % args.plugin)
-        return 2
-    LoadPlugin(args.plugin, remote=False, ns=globals())
+    def default():
+        stretched = Transform(Input=Sphere(Radius=0.5, ThetaResolution=48, PhiResolution=96))
+        stretched.Transform.Scale = [0.6, 2.0, 0.6]
+        return stretched
 
-    if args.mesh:
-        if args.mesh.lower().endswith(".off"):
-            mesh = OFFMeshReader(FileName=args.mesh)
-        else:
-            mesh = OpenDataFile(args.mesh)
-        if mesh is None:
-            print("error: cannot open %s" % args.mesh)
-            return 2
-        mesh = ExtractSurface(Input=mesh)  # any dataset -> polydata
-    else:
-        sphere = Sphere(Radius=0.5, ThetaResolution=48, PhiResolution=96)
-        mesh = Transform(Input=sphere)
-        mesh.Transform.Scale = [0.6, 2.0, 0.6]
+    mesh = ex.open_input(args, globals(), default)
+    if mesh is None:
+        return 2
     mesh = Clean(Input=mesh)  # OBJ readers split points along seams: merge them (the cage does too)
     mesh = GenerateSurfaceNormals(Input=mesh, Splitting=0)  # smooth shading, no split points
 
@@ -99,7 +79,7 @@ def main():
     for kind in ("Mean Value", "Green"):
         deform = CageDeformation(Input=mesh, RestCage=cage, DeformedCage=bent, Coordinates=kind)
         deform.UpdatePipeline()
-        data = servermanager.Fetch(deform)
+        data = ex.fetch(deform)
         if data.GetNumberOfPoints() == 0:
             print("error: %s: %s" % (kind, field(data, "LastErrorMessage")))
             return 1
@@ -111,60 +91,18 @@ def main():
     print("encloses       : %s (points outside or on the rest cage: %d)" % ("yes" if outside == 0 else "NO", outside))
 
     # three panels side by side: rest, mean value, Green (each with its cage)
-    bounds = servermanager.Fetch(cage).GetBounds()
+    bounds = ex.fetch(cage).GetBounds()
     shift = 1.25 * builtins.max(bounds[1] - bounds[0], bounds[3] - bounds[2])
 
-    def moved(source, k):
-        t = Transform(Input=source)
-        t.Transform.Translate = [k * shift, 0.0, 0.0]
-        return t
-
-    view = CreateView("RenderView")
-    view.ViewSize = [1800, 800]
-    view.Background = [1.0, 1.0, 1.0]
-    view.OrientationAxesVisibility = 0
-    try:
-        view.UseColorPaletteForBackground = 0
-    except AttributeError:
-        pass
+    view = ex.white_view(1800, 800)
     panels = [(mesh, cage, "rest: the mesh in its %d-vertex cage" % args.vertices),
               (results["Mean Value"][0], bent, "mean value coordinates"),
               (results["Green"][0], bent, "Green coordinates")]
-    labels = []
-    for k, (surface, wire, label) in enumerate(panels):
-        s = Show(moved(surface, k), view)
-        s.ColorArrayName = ["POINTS", ""]
-        s.DiffuseColor = [0.78, 0.74, 0.68]
-        s.Specular = 0.3
-        w = Show(moved(wire, k), view)
-        w.SetRepresentationType("Wireframe")
-        w.ColorArrayName = ["POINTS", ""]
-        w.AmbientColor = [0.15, 0.35, 0.75]
-        w.DiffuseColor = [0.15, 0.35, 0.75]
-        w.Opacity = 0.35
-        labels.append(Text(Text=label))
-    # parallel projection framing the three panels (each panel's centre known: labels above them)
-    width, height = 2.0 * shift + (bounds[1] - bounds[0]), bounds[3] - bounds[2]
-    aspect = 1800.0 / 800.0
-    scale = builtins.max(0.62 * height, 0.53 * width / aspect)
-    centre = [shift + 0.5 * (bounds[0] + bounds[1]), 0.5 * (bounds[2] + bounds[3]) + 0.04 * height,
-              0.5 * (bounds[4] + bounds[5])]
-    Render(view)  # the first render resets the camera: set ours after it
-    view.CameraParallelProjection = 1
-    view.CameraFocalPoint = centre
-    view.CameraPosition = [centre[0], centre[1], centre[2] + 10.0 * width]
-    view.CameraViewUp = [0.0, 1.0, 0.0]
-    view.CameraParallelScale = scale
-    for k, label in enumerate(labels):
-        t = Show(label, view)
-        t.WindowLocation = "Any Location"
-        t.Justification = "Center"
-        t.Position = [0.5 + (k - 1) * shift / (2.0 * scale * aspect) - 0.1, 0.9]
-        t.FontSize = 22
-        t.Color = [0.1, 0.1, 0.1]
-    Render(view)
-    SaveScreenshot(args.screenshot, view, ImageResolution=[1800, 800])
-    print("screenshot     : %s" % args.screenshot)
+    for k, (surface, wire, _) in enumerate(panels):
+        ex.show_in_cage(view, surface, wire, k * shift, opacity=0.35)
+    labels = [label for _, _, label in panels]
+    ex.frame_and_save(view, bounds, shift, labels, (1800, 800), args.screenshot, fill=(0.62, 0.53), lift=0.04,
+                      label_dx=0.1, font=22)
     Delete(view)
     del view
     return 0 if outside == 0 else 1

@@ -9,59 +9,34 @@ verdicts, and saves a screenshot: the input (grey, translucent) under the cage c
 DistanceToInput (translucent, with its edges). Rendering needs an X server: on a machine without
 a display run it under `xvfb-run -a`.
 """
-import argparse
 import os
 import sys
 
-from paraview.simple import *  # noqa: F401,F403
-from paraview import servermanager
-
-HERE = os.path.dirname(os.path.abspath(__file__))
-DEFAULT_PLUGIN = os.path.join(HERE, "..", "..", "build", "lib", "paraview-5.11", "plugins",
-                              "SDFCage", "SDFCage.so")
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from paraview.simple import *  # noqa: E402,F401,F403
+import sdfcage_example as ex  # noqa: E402
 
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("mesh", nargs="?", help="closed surface mesh (default: a sphere)")
-    parser.add_argument("--plugin", default=os.environ.get("SDFCAGE_PLUGIN", DEFAULT_PLUGIN),
-                        help="path of SDFCage.so (default: the build tree's, or $SDFCAGE_PLUGIN)")
+    parser = ex.parser(__doc__, "closed surface mesh (default: a sphere)", "cage_quality.png")
     parser.add_argument("-n", "--vertices", type=int, default=200, help="cage vertices (200)")
     parser.add_argument("--iso", type=float, default=0.02, help="isovalue, relative (0.02)")
-    parser.add_argument("--screenshot", default="cage_quality.png", help="PNG to write")
     args = parser.parse_args()
-
-    if not os.path.isfile(args.plugin):
-        print("error: plugin not found: %s (build the project or pass --plugin)" % args.plugin)
+    mesh = ex.open_input(args, globals(), lambda: Sphere(Radius=1.0, ThetaResolution=48, PhiResolution=48))
+    if mesh is None:
         return 2
-    LoadPlugin(args.plugin, remote=False, ns=globals())
-
-    if args.mesh:
-        if args.mesh.lower().endswith(".off"):
-            mesh = OFFMeshReader(FileName=args.mesh)
-        else:
-            mesh = OpenDataFile(args.mesh)
-        if mesh is None:
-            print("error: cannot open %s" % args.mesh)
-            return 2
-        mesh = ExtractSurface(Input=mesh)  # any dataset -> polydata
-    else:
-        mesh = Sphere(Radius=1.0, ThetaResolution=48, PhiResolution=48)
 
     cage = SDFCage(Input=mesh, TargetNumberOfVertices=args.vertices, IsoValue=args.iso)
     quality = CageQuality(Input=cage, Source=mesh)
     quality.UpdatePipeline()
 
-    data = servermanager.Fetch(quality)
-    fd = data.GetFieldData()
+    data = ex.fetch(quality)
 
     def value(name):
-        array = fd.GetAbstractArray(name)
-        return None if array is None else array.GetValue(0)
+        return ex.field(data, name)
 
     if data.GetNumberOfPoints() == 0:
-        status = servermanager.Fetch(cage).GetFieldData().GetAbstractArray("LastErrorMessage")
-        print("error: no cage: %s" % (status.GetValue(0) if status else "unknown reason"))
+        print("error: no cage: %s" % (ex.field(ex.fetch(cage), "LastErrorMessage") or "unknown reason"))
         return 1
     print("cage           : %d points, %d triangles" % (data.GetNumberOfPoints(), data.GetNumberOfCells()))
     print("encloses       : %s %s" % ("yes" if value("Encloses") == 1 else "NO", value("QualityMessage")))
@@ -72,14 +47,7 @@ def main():
     print("mean distance  : %.6g" % value("MeanDistanceCageToInput"))
     print("genus          : cage %d, input %d" % (value("CageGenus"), value("InputGenus")))
 
-    view = CreateView("RenderView")
-    view.ViewSize = [1200, 800]
-    view.Background = [1.0, 1.0, 1.0]
-    view.OrientationAxesVisibility = 0
-    try:
-        view.UseColorPaletteForBackground = 0
-    except AttributeError:
-        pass
+    view = ex.white_view(1200, 800)
     meshDisplay = Show(mesh, view)
     meshDisplay.DiffuseColor = [0.75, 0.75, 0.75]
     meshDisplay.Opacity = 0.5

@@ -16,64 +16,43 @@ needs an X server: on a machine without a display run it under `xvfb-run -a`.
     xvfb-run -a pvpython Examples/ParaView/nested_cages.py ../shared/data/bunny.off \\
         --screenshot docs/nested.png
 """
-import argparse
 import builtins
 import os
 import sys
 
-from paraview.simple import *  # noqa: F401,F403
-from paraview import servermanager
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from paraview.simple import *  # noqa: E402,F401,F403
+import sdfcage_example as ex  # noqa: E402
 
-HERE = os.path.dirname(os.path.abspath(__file__))
-DEFAULT_PLUGIN = os.path.join(HERE, "..", "..", "build", "lib", "paraview-5.11", "plugins",
-                              "SDFCage", "SDFCage.so")
+field = ex.field
 
 # inner to outer: warm to cool
 COLORS = [[0.85, 0.33, 0.10], [0.20, 0.55, 0.25], [0.15, 0.35, 0.75], [0.45, 0.25, 0.60]]
 
 
-def field(data, name):
-    array = data.GetFieldData().GetAbstractArray(name)
-    return None if array is None else array.GetValue(0)
-
 
 def main():
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("mesh", nargs="?", help="closed surface mesh (default: a sphere beside a torus)")
-    parser.add_argument("--plugin", default=os.environ.get("SDFCAGE_PLUGIN", DEFAULT_PLUGIN),
-                        help="path of SDFCage.so (default: the build tree's, or $SDFCAGE_PLUGIN)")
+    parser = ex.parser(__doc__, "closed surface mesh (default: a sphere beside a torus)", "nested_cages.png")
     parser.add_argument("-n", "--vertices", default="2000,500,100",
                         help="vertex counts of the levels, comma-separated (2000,500,100)")
-    parser.add_argument("--screenshot", default="nested_cages.png", help="PNG to write")
     args = parser.parse_args()
     counts = sorted((int(v) for v in args.vertices.split(",")), reverse=True)
 
-    if not os.path.isfile(args.plugin):
-        print("error: plugin not found: %s (build the project or pass --plugin)" % args.plugin)
-        return 2
-    LoadPlugin(args.plugin, remote=False, ns=globals())
-
-    if args.mesh:
-        if args.mesh.lower().endswith(".off"):
-            mesh = OFFMeshReader(FileName=args.mesh)
-        else:
-            mesh = OpenDataFile(args.mesh)
-        if mesh is None:
-            print("error: cannot open %s" % args.mesh)
-            return 2
-        mesh = ExtractSurface(Input=mesh)
-    else:
+    def default():
         sphere = Sphere(Radius=0.5, Center=[-1.1, 0.0, 0.0], ThetaResolution=48, PhiResolution=48)
         torus = Superquadric(Toroidal=1, Thickness=0.35, Size=0.5, Center=[0.6, 0.0, 0.0],
                              ThetaResolution=64, PhiResolution=32)
-        mesh = AppendDatasets(Input=[sphere, ExtractSurface(Input=torus)])
-        mesh = ExtractSurface(Input=mesh)
+        return ExtractSurface(Input=AppendDatasets(Input=[sphere, ExtractSurface(Input=torus)]))
+
+    mesh = ex.open_input(args, globals(), default)
+    if mesh is None:
+        return 2
     mesh = Clean(Input=mesh)  # OBJ/STL readers split points: merge them (the cage does too)
     mesh = GenerateSurfaceNormals(Input=mesh, Splitting=0)
 
     cage = SDFCage(Input=mesh, NestedLevels=counts)
     cage.UpdatePipeline()
-    finest = servermanager.Fetch(cage)
+    finest = ex.fetch(cage)
     status = field(finest, "Status")
     if status != "Ok":
         print("error: SDF Cage: %s: %s" % (status, field(finest, "LastErrorMessage")))
@@ -89,7 +68,7 @@ def main():
         level = ExtractSurface(Input=MergeBlocks(Input=block))
         judge = CageQuality(Input=level, Source=inside)
         judge.UpdatePipeline()
-        q = servermanager.Fetch(judge)
+        q = ex.fetch(judge)
         levels.append(level)
         inside = level
         encloses = field(q, "Encloses") == 1
@@ -101,26 +80,17 @@ def main():
     print("encloses       : %s" % ("yes" if ok else "NO"))
 
     # panels: the input and each level around the level inside it, then a cut through all
-    bounds = servermanager.Fetch(levels[-1]).GetBounds()
+    bounds = ex.fetch(levels[-1]).GetBounds()
     size = [bounds[1] - bounds[0], bounds[3] - bounds[2], bounds[5] - bounds[4]]
     shift = 1.15 * builtins.max(size[0], size[2])
     centre = [0.5 * (bounds[0] + bounds[1]), 0.5 * (bounds[2] + bounds[3]), 0.5 * (bounds[4] + bounds[5])]
     panels = len(counts) + 1
     width_px, height_px = 520 * panels, 520
 
-    view = CreateView("RenderView")
-    view.ViewSize = [width_px, height_px]
-    view.Background = [1.0, 1.0, 1.0]
-    view.OrientationAxesVisibility = 0
-    try:
-        view.UseColorPaletteForBackground = 0
-    except AttributeError:
-        pass
+    view = ex.white_view(width_px, height_px)
 
     def moved(source, k):
-        t = Transform(Input=source)
-        t.Transform.Translate = [k * shift, 0.0, 0.0]
-        return t
+        return ex.translated(source, k * shift)
 
     def solid(source, k, color, opacity=1.0):
         d = Show(moved(source, k), view)
