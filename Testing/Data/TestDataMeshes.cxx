@@ -13,6 +13,7 @@
 #include "Pipeline/CageGenerator.h"
 #include "ExactCheck.h"
 #include "MeshIO.h"
+#include "DataTestSupport.h"
 #include "Optimization/Optimization.h"
 
 #include <gtest/gtest.h>
@@ -30,8 +31,8 @@ using namespace sdfcage;
 namespace
 {
 
+datatest::Arguments gArgs;
 std::string gMesh;
-std::string gDataDir;
 bool gAny = false;
 bool gInward = false;
 int gVertices = -1; // < 0: the default of CageOptions
@@ -51,14 +52,7 @@ std::string baseName(const std::string& path)
 
 TEST(DataMesh, GenerateCage)
 {
-  if (gMesh.empty())
-  {
-    GTEST_SKIP() << "no test meshes: the data folder '" << gDataDir << "' is absent or empty (set SDFCAGE_DATA_DIR)";
-  }
-  if (!std::ifstream(gMesh).good())
-  {
-    GTEST_SKIP() << "mesh '" << gMesh << "' is absent (re-run CMake after changing the data folder)";
-  }
+  SDFCAGE_SKIP_WITHOUT_MESH(gMesh, gArgs.DataDir);
   const std::string name = baseName(gMesh);
 
   auto t0 = std::chrono::steady_clock::now();
@@ -219,35 +213,11 @@ TEST(DataMesh, GenerateCage)
 
 int main(int argc, char** argv)
 {
-  ::testing::InitGoogleTest(&argc, argv);
-  for (int i = 1; i < argc; ++i)
-  {
-    const std::string arg = argv[i];
-    if (arg.rfind("--mesh=", 0) == 0)
-    {
-      gMesh = arg.substr(7);
-    }
-    else if (arg.rfind("--data-dir=", 0) == 0)
-    {
-      gDataDir = arg.substr(11);
-    }
-    else if (arg == "--any")
-    {
-      gAny = true;
-    }
-    else if (arg.rfind("--vertices=", 0) == 0)
-    {
-      gVertices = std::stoi(arg.substr(11));
-    }
-    else if (arg == "--inward")
-    {
-      gInward = true;
-    }
-    else
-    {
-      std::cerr << "SDFCageDataTests: unknown argument '" << arg << "'\n";
-      return 2;
-    }
-  }
+  if (!datatest::parseArguments(argc, argv, "SDFCageDataTests", { "any", "inward" }, { "vertices" }, gArgs))
+    return 2;
+  gMesh = gArgs.Mesh;
+  gAny = gArgs.has("any");
+  gInward = gArgs.has("inward");
+  gVertices = std::stoi(gArgs.value("vertices", "-1"));
   return RUN_ALL_TESTS();
 }

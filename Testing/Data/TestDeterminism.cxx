@@ -10,6 +10,7 @@
 // first output that differs and where.
 #include "Pipeline/CageGenerator.h"
 #include "MeshIO.h"
+#include "DataTestSupport.h"
 
 #include <gtest/gtest.h>
 
@@ -24,9 +25,7 @@ using namespace sdfcage;
 namespace
 {
 
-std::string gMesh;
-std::string gDataDir;
-bool gOptimize = false;
+datatest::Arguments gArgs;
 
 /// "" when a and b are the same bit for bit, else where they first differ.
 std::string compareMeshes(const TriangleMesh& a, const TriangleMesh& b)
@@ -78,24 +77,17 @@ std::string compareValues(const std::vector<double>& a, const std::vector<double
 
 TEST(Determinism, SameCageOnOneAndTwoThreads)
 {
-  if (gMesh.empty())
-  {
-    GTEST_SKIP() << "no test meshes: the data folder '" << gDataDir << "' is absent or empty (set SDFCAGE_DATA_DIR)";
-  }
-  if (!std::ifstream(gMesh).good())
-  {
-    GTEST_SKIP() << "mesh '" << gMesh << "' is absent (re-run CMake after changing the data folder)";
-  }
+  SDFCAGE_SKIP_WITHOUT_MESH(gArgs.Mesh, gArgs.DataDir);
   PolygonMesh polygons;
   std::string error;
-  ASSERT_TRUE(exact::readPolygonMesh(gMesh, polygons, error)) << error;
+  ASSERT_TRUE(exact::readPolygonMesh(gArgs.Mesh, polygons, error)) << error;
 
   CageResult results[2];
   for (int k = 0; k < 2; ++k)
   {
     CageOptions options;
     options.NumberOfThreads = k + 1;
-    options.Optimize = gOptimize;
+    options.Optimize = gArgs.has("optimize");
     results[k] = generateCage(polygons, options);
     std::cout << "[ threads  ] " << (k + 1) << ": " << statusName(results[k].State) << ", envelope "
               << results[k].Envelope.Points.size() << " points, cage " << results[k].Cage.Points.size()
@@ -126,21 +118,7 @@ TEST(Determinism, SameCageOnOneAndTwoThreads)
 
 int main(int argc, char** argv)
 {
-  ::testing::InitGoogleTest(&argc, argv);
-  for (int i = 1; i < argc; ++i)
-  {
-    const std::string arg = argv[i];
-    if (arg.rfind("--mesh=", 0) == 0)
-      gMesh = arg.substr(7);
-    else if (arg.rfind("--data-dir=", 0) == 0)
-      gDataDir = arg.substr(11);
-    else if (arg == "--optimize")
-      gOptimize = true;
-    else
-    {
-      std::cerr << "SDFCageDeterminismTests: unknown argument '" << arg << "'\n";
-      return 2;
-    }
-  }
+  if (!datatest::parseArguments(argc, argv, "SDFCageDeterminismTests", { "optimize" }, {}, gArgs))
+    return 2;
   return RUN_ALL_TESTS();
 }

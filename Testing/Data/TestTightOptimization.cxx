@@ -11,6 +11,7 @@
 #include "../Core/CoreTestPrinters.h"
 #include "ExactCheck.h"
 #include "MeshIO.h"
+#include "DataTestSupport.h"
 #include "Mesh/Normalization.h"
 #include "Mesh/Validation.h"
 #include "Optimization/Optimization.h"
@@ -30,7 +31,7 @@ using namespace sdfcage;
 namespace
 {
 
-std::string gMesh;
+datatest::Arguments gArgs;
 
 struct Prepared
 {
@@ -38,15 +39,13 @@ struct Prepared
   CageResult Cage;
 };
 
-/// Reads gMesh and builds its 500-vertex cage; false (with a skip or a failure) when it cannot.
+/// Reads the mesh and builds its 500-vertex cage; false (with a failure) when it cannot.
 bool prepare(Prepared& p)
 {
-  if (gMesh.empty() || !std::ifstream(gMesh).good())
-    return false;
   PolygonMesh polygons;
   std::string error;
-  EXPECT_TRUE(exact::readPolygonMesh(gMesh, polygons, error)) << error;
-  EXPECT_TRUE(prepareMesh(polygons, p.Input).usable()) << gMesh << " is not a closed mesh";
+  EXPECT_TRUE(exact::readPolygonMesh(gArgs.Mesh, polygons, error)) << error;
+  EXPECT_TRUE(prepareMesh(polygons, p.Input).usable()) << gArgs.Mesh << " is not a closed mesh";
   CageOptions o;
   o.TargetNumberOfVertices = 500;
   p.Cage = generateCage(PolygonMesh::fromTriangles(p.Input), o);
@@ -77,13 +76,10 @@ void expectGuarantees(const Prepared& p, const OptimizeResult& r, const char* wh
 
 TEST(Tight, MIPS)
 {
+  SDFCAGE_SKIP_WITHOUT_MESH(gArgs.Mesh, gArgs.DataDir);
   Prepared p;
   if (!prepare(p))
-  {
-    if (!HasFailure())
-      GTEST_SKIP() << "mesh '" << gMesh << "' is absent";
     return;
-  }
   OptimizeOptions o; // the defaults of --optimize mips
   o.Clearance = CageOptions().Envelope.clearance();
   const OptimizeResult r = optimizeCageInInputUnits(p.Cage.Cage, p.Input, o);
@@ -91,7 +87,7 @@ TEST(Tight, MIPS)
   const CageQualityResult q0 = evaluateCage(p.Input, p.Cage.Cage);
   const CageQualityResult q1 = evaluateCage(p.Input, r.Cage);
   const double ratio = q1.HausdorffCageToInputBound / q0.HausdorffCageToInputBound;
-  std::cout << "[ tight    ] " << gMesh << ": min angle " << r.MinimumAngleBefore << " -> " << r.MinimumAngleAfter
+  std::cout << "[ tight    ] " << gArgs.Mesh << ": min angle " << r.MinimumAngleBefore << " -> " << r.MinimumAngleAfter
             << " deg, angles < 15: " << 100 * r.SmallAnglesBefore << "% -> " << 100 * r.SmallAnglesAfter
             << "%, Hausdorff cage->input / diagonal " << q0.HausdorffCageToInputBound / q0.Diagonal << " -> "
             << q1.HausdorffCageToInputBound / q1.Diagonal << " (x" << ratio << "), " << r.Sweeps << " sweeps, "
@@ -102,13 +98,10 @@ TEST(Tight, MIPS)
 
 TEST(Tight, Spacing)
 {
+  SDFCAGE_SKIP_WITHOUT_MESH(gArgs.Mesh, gArgs.DataDir);
   Prepared p;
   if (!prepare(p))
-  {
-    if (!HasFailure())
-      GTEST_SKIP() << "mesh '" << gMesh << "' is absent";
     return;
-  }
   const double h = 0.05;
   OptimizeOptions o;
   o.Energy = CageEnergy::Spacing;
@@ -142,16 +135,14 @@ TEST(Tight, Spacing)
             in += area;
         }
   }
-  std::cout << "[ spacing  ] " << gMesh << ": " << 100 * in / all << "% of the area within h +- 20% (h = " << h
+  std::cout << "[ spacing  ] " << gArgs.Mesh << ": " << 100 * in / all << "% of the area within h +- 20% (h = " << h
             << "), " << r.Sweeps << " sweeps, " << r.Seconds << " s\n";
   EXPECT_GE(in / all, 0.9);
 }
 
 int main(int argc, char** argv)
 {
-  ::testing::InitGoogleTest(&argc, argv);
-  for (int i = 1; i < argc; ++i)
-    if (!std::strncmp(argv[i], "--mesh=", 7))
-      gMesh = argv[i] + 7;
+  if (!datatest::parseArguments(argc, argv, "SDFCageTightDataTests", {}, {}, gArgs))
+    return 2;
   return RUN_ALL_TESTS();
 }
