@@ -5,6 +5,7 @@ Run: mpiexec -np 2 pvbatch TestMPIPieces.py <SDFCage.so> <scratch dir> [data dir
 a serial run of the same filter, made here on rank 0 with the plain VTK classes of the `sdfcage`
 package (a plain Update() asks for the whole input, piece 0 of 1: it runs on this rank alone).
 """
+import builtins
 import os
 import sys
 
@@ -134,6 +135,43 @@ chk.check(contour.GetDataInformation().GetNumberOfPoints() == fe.GetOutput().Get
 contour.Isosurfaces = [0.01]
 contour.UpdatePipeline()
 chk.check(contour.GetDataInformation().GetNumberOfPoints() > 0, "the contour updated again")
+
+# --- 1b. nested levels (port 3, a multiblock with one block per level) ----------------------------
+LEVELS = [120, 40]
+nested = SDFCage(Input=sphere, NestedLevels=LEVELS, IsoValue=0.04)
+nested.UpdatePipeline()
+ref_nested = sdfcage.vtkSDFCageFilter()
+ref_nested.SetInputData(whole)
+ref_nested.SetIsoValue(0.04)
+ref_nested.SetNumberOfNestedLevels(len(LEVELS))
+for k, n in enumerate(LEVELS):
+    ref_nested.SetNestedVertexCount(k, n)
+ref_nested.Update()
+ref_levels = ref_nested.GetOutputDataObject(3)
+chk.check(ref_levels.GetNumberOfBlocks() == len(LEVELS) and
+          [ref_levels.GetBlock(k).GetNumberOfPoints() for k in range(len(LEVELS))] == LEVELS,
+          "serial reference: the levels have %s points" % LEVELS)
+chk.check(nested.GetDataInformation(3).GetNumberOfPoints() == builtins.sum(LEVELS),
+          "nested output: %d points over all ranks, %d serial"
+          % (nested.GetDataInformation(3).GetNumberOfPoints(), builtins.sum(LEVELS)))
+# the levels live on rank 0: Fetch(proxy, 0, idx=3) brings its multiblock whole (a plain Fetch of
+# a composite output groups every rank's multiblock as one block per rank, ParaView's rule)
+on_root = servermanager.Fetch(nested, 0, idx=3)
+names = [on_root.GetMetaData(k).Get(on_root.NAME()) for k in range(on_root.GetNumberOfBlocks())]
+chk.check(names == ["cage_%d" % n for n in LEVELS], "rank 0's nested output: blocks %s" % names)
+for k, n in enumerate(LEVELS):
+    same_surface(chk, "nested level cage_%d" % n, on_root.GetBlock(k), ref_levels.GetBlock(k))
+grouped = servermanager.Fetch(nested, idx=3)
+chk.check(grouped.GetNumberOfBlocks() == ranks and grouped.GetBlock(0).GetNumberOfPoints() == builtins.sum(LEVELS)
+          and builtins.sum(grouped.GetBlock(r).GetNumberOfPoints() for r in range(1, ranks)) == 0,
+          "a plain Fetch: one block per rank, rank 0's holding the %d points" % builtins.sum(LEVELS))
+for n in LEVELS:
+    level = MergeBlocks(Input=ExtractBlock(Input=OutputPort(nested, 3), Selectors=["/Root/cage_%d" % n]))
+    level.UpdatePipeline()
+    chk.check(level.GetDataInformation().GetNumberOfPoints() == n,
+              "Extract Block cage_%d: %d points over all ranks" % (n, level.GetDataInformation().GetNumberOfPoints()))
+    Delete(level)
+Delete(nested)
 
 # --- 2. the quality and optimize filters on distributed inputs ------------------------------------
 quality = CageQuality(Input=cage, Source=sphere)
