@@ -4,8 +4,9 @@
 # server connection of the rendering tests has been seen to drop once in a while, a real failure
 # fails twice); tests needing ../shared/data skip when it is
 # absent. Two tests run at a time (2 cores). Then .ci/fuzz.sh fuzzes the readers and Core for a few
-# minutes, and .ci/asan.sh runs the fast part of Core's and the filters' tests under AddressSanitizer
-# and UndefinedBehaviorSanitizer (the same sanitized build, build-fuzz/).
+# minutes, .ci/asan.sh runs the fast part of Core's and the filters' tests under AddressSanitizer
+# and UndefinedBehaviorSanitizer (the same sanitized build, build-fuzz/), and .ci/plain-vtk.sh
+# builds against plain VTK (the last two while they fit in CI's time: see below).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 xvfb-run -a ctest --test-dir build -j2 -LE rendering --output-on-failure --repeat until-pass:2 "$@"
@@ -13,6 +14,28 @@ xvfb-run -a ctest --test-dir build -j2 -LE rendering --output-on-failure --repea
 xvfb-run -a ctest --test-dir build -L rendering --output-on-failure --repeat until-pass:2 "$@"
 # then the fuzzers (libFuzzer + ASan/UBSan, a bounded time each; build-fuzz/)
 bash .ci/fuzz.sh
-# The sanitizer tests (.ci/asan.sh: ASan + UBSan + LSan on the fast part of Core's and the
-# filters' tests) are run by hand for now: their build and run are estimated at 15-20 minutes more
-# on 2 cores and were not yet timed from a fresh clone against CI's 90 minutes.
+
+# Then two stages that each take 15-30 minutes on 2 cores, while they fit in CI's time: the
+# sanitizer tests (.ci/asan.sh: ASan + UBSan + LSan on the fast part of Core's and the filters'
+# tests, in the fuzzers' build) and the build against Debian's plain VTK 9.1 in a brand-new root
+# (.ci/plain-vtk.sh). A stage starts only if the time it may need is left before
+# SDFCAGE_CI_MINUTES (80) after the start of .ci/run (SDFCAGE_CI_START, else this script's start);
+# one that does not start says so in capitals; one that starts must pass within the time left.
+start="${SDFCAGE_CI_START:-$(date +%s)}"
+limit=$((${SDFCAGE_CI_MINUTES:-80} * 60))
+stage() {
+  local name="$1" need="$2"
+  shift 2
+  local used=$(($(date +%s) - start))
+  local left=$((limit - used))
+  if [ "$left" -lt "$need" ]; then
+    echo "ci: $name NOT RUN: $((used / 60)) min used of $((limit / 60)), it may need $((need / 60)) min"
+    return 0
+  fi
+  echo "ci: $name (at $((used / 60)) min of $((limit / 60)))"
+  local t0=$SECONDS
+  timeout "$left" "$@"
+  echo "ci: $name passed in $((SECONDS - t0)) s"
+}
+stage "sanitizer tests (.ci/asan.sh)" 1500 bash .ci/asan.sh
+stage "plain VTK build (.ci/plain-vtk.sh)" 1500 bash .ci/plain-vtk.sh

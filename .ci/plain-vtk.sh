@@ -1,0 +1,47 @@
+#!/bin/bash
+# Plain VTK stays supported: builds SDFCage against Debian's own VTK 9.1 (libvtk9-dev,
+# python3-vtk9; no ParaView, -DSDFCAGE_USE_PARAVIEW=OFF) in a brand-new Debian 12 root, makes a
+# cage of the built-in shape with the program (exit code 0 only for a verified cage), checks the
+# cage file, and imports the Python package. Debian's VTK 9.1 and ParaView's VTK 9.2 cannot be
+# installed in one root, so this runs in a root of its own, made by the fresh-machine tool
+# (../shared/tools/fresh-machine/fresh.sh, or $SDFCAGE_FRESH); it needs root and the Debian
+# archive. Called by .ci/test.sh. SDFCAGE_PLAIN_VTK=skip skips it (for a run that is itself inside
+# such a root, where a root in a root is not possible).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+if [ "${SDFCAGE_PLAIN_VTK:-}" = skip ]; then
+  echo "plain-vtk: skipped (SDFCAGE_PLAIN_VTK=skip)"
+  exit 0
+fi
+fresh=${SDFCAGE_FRESH:-../shared/tools/fresh-machine/fresh.sh}
+if [ ! -f "$fresh" ]; then
+  echo "plain-vtk: NOT CHECKED: the fresh-machine tool ($fresh) is not on this machine;" \
+       "set SDFCAGE_FRESH to its path to build against plain VTK here"
+  exit 0
+fi
+
+# the same packages as .ci/setup.sh, with Debian's VTK in place of ParaView's
+packages="cmake ninja-build g++ libeigen3-dev libtbb-dev libopenvdb-dev libboost-iostreams-dev
+  libvtk9-dev python3-vtk9 python3-dev"
+start=$(date +%s)
+bash "$fresh" . "set -e
+  apt-get update -qq
+  apt-get install -y -qq --no-install-recommends $(echo $packages) >/dev/null
+  cmake -S . -B build-vtk -G Ninja -DCMAKE_BUILD_TYPE=Release -DSDFCAGE_USE_PARAVIEW=OFF \
+    -DSDFCAGE_BUILD_TESTING=OFF -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
+  cmake --build build-vtk -j2 | tail -n 2
+  build-vtk/bin/sdfcage -n 200 -o /tmp/builtin_cage.vtp
+  python3 -c \"
+import sys, glob
+from vtkmodules.vtkIOXML import vtkXMLPolyDataReader
+r = vtkXMLPolyDataReader(); r.SetFileName('/tmp/builtin_cage.vtp'); r.Update()
+n = r.GetOutput().GetNumberOfPoints()
+print('plain-vtk: the cage file has', n, 'points')
+sys.exit(0 if n == 200 else 1)\"
+  PYTHONPATH=build-vtk/lib/python3/dist-packages python3 -c \"
+import sdfcage
+f = sdfcage.vtkSDFCageFilter()
+print('plain-vtk: import sdfcage:', sdfcage.__file__, f.GetClassName())\"
+"
+echo "plain-vtk: passed in $(( $(date +%s) - start )) s"
