@@ -152,8 +152,10 @@ void printUsage(std::ostream& os)
         "enclose INPUT? Exit codes: 0 it encloses, 1 it does not, 2 a file cannot be used.\n"
         "\n"
         "Exit codes: 0 cage written and enclosure verified; 1 enclosure not verified;\n"
-        "2 bad command line or unusable input (missing file, unknown format, no triangle,\n"
-        "NaN coordinates, ...); 3 an output could not be written or rendered; 130 interrupted.\n";
+        "2 bad command line, unusable input (missing file, unknown format, no triangle,\n"
+        "NaN coordinates, ...) or an output path that cannot be written (checked before any\n"
+        "computing); 3 an output could not be written or rendered after the run, the memory\n"
+        "budget was exceeded, or another failure; 130 interrupted.\n";
 }
 
 struct Options

@@ -210,6 +210,22 @@ if reader is not None:
     check(back.GetNumberOfPoints() == out.GetNumberOfPoints()
           and back.GetNumberOfPolys() == out.GetNumberOfPolys(), "the cage reads back identically")
 
+# --- the memory budget: a 1 MiB limit stops the run before its grid, with the need named ----------
+check(cage.MemoryLimit == 0, "MemoryLimit default 0 (automatic)")
+tight = SDFCage(Input=Sphere(ThetaResolution=32, PhiResolution=32), MemoryLimit=1)
+from vtkmodules.vtkCommonCore import vtkLogger  # noqa: E402
+verbosity = vtkLogger.GetCurrentVerbosityCutoff()
+vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_OFF)  # the failure is reported as a VTK error: expected here
+tight_out = servermanager.Fetch(tight)
+vtkLogger.SetStderrVerbosity(verbosity)
+tight_status = tight_out.GetFieldData().GetAbstractArray("Status")
+tight_msg = tight_out.GetFieldData().GetAbstractArray("LastErrorMessage")
+check(tight_out.GetNumberOfPoints() == 0 and tight_status is not None and tight_status.GetValue(0) == "Failed",
+      "MemoryLimit 1 MiB: no cage, status Failed (%s)" % (tight_status.GetValue(0) if tight_status else None))
+check(tight_msg is not None and "memory limit of 1 MiB" in tight_msg.GetValue(0),
+      "MemoryLimit 1 MiB: the message names the need and the limit (%s)" % (tight_msg.GetValue(0) if tight_msg else None))
+Delete(tight)
+
 knight = os.path.join(data_dir, "decimated-knight.off") if data_dir else ""
 if knight and os.path.exists(knight):
     k = OFFMeshReader(FileName=knight)
