@@ -470,6 +470,34 @@ vtkSmartPointer<vtkPolyData> JoinPieces(const std::vector<vtkPolyData*>& pieces,
 }
 
 //------------------------------------------------------------------------------
+vtkSmartPointer<vtkPolyData> JoinOnEveryProcess(vtkMultiProcessController* controller, vtkPolyData* piece)
+{
+  vtkNew<vtkPolyData> send;
+  if (piece)
+  {
+    send->ShallowCopy(piece);
+  }
+  std::vector<vtkSmartPointer<vtkDataObject>> received;
+  controller->Gather(send, received, 0);
+  vtkSmartPointer<vtkPolyData> whole;
+  if (controller->GetLocalProcessId() == 0)
+  {
+    std::vector<vtkPolyData*> pieces;
+    for (const auto& object : received)
+    {
+      pieces.push_back(vtkPolyData::SafeDownCast(object));
+    }
+    whole = JoinPieces(pieces);
+  }
+  if (!whole)
+  {
+    whole = vtkSmartPointer<vtkPolyData>::New();
+  }
+  controller->Broadcast(whole, 0);
+  return whole;
+}
+
+//------------------------------------------------------------------------------
 int RunOnWholeSurface(vtkAlgorithm* self, vtkInformationVector** inputVector, vtkInformationVector* outputVector,
   const WholeSurfaceRun& run, const ExecuteFunction& execute, const AdoptFunction& adopt)
 {

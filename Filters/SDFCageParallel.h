@@ -51,6 +51,11 @@ vtkMultiProcessController* DistributingController(vtkInformationVector** inputVe
 /// Null pieces are skipped. Exposed for tests.
 vtkSmartPointer<vtkPolyData> JoinPieces(const std::vector<vtkPolyData*>& pieces, vtkIdType* mergedPoints = nullptr);
 
+/// The whole of a surface handed out in pieces, on every process (collective): the pieces are
+/// gathered on process 0, joined (JoinPieces) and broadcast. A null piece counts as empty; the
+/// result is empty (never null) when every piece is.
+vtkSmartPointer<vtkPolyData> JoinOnEveryProcess(vtkMultiProcessController* controller, vtkPolyData* piece);
+
 /// The body of a filter's RequestData, given its inputs (one vtkPolyData per input port,
 /// connection 0, nullptr where there is none) and the filter's output vector.
 using ExecuteFunction = std::function<int(const std::vector<vtkPolyData*>& inputs)>;

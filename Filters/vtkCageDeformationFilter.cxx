@@ -15,6 +15,8 @@
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkIntArray.h"
+#include "vtkCommunicator.h"
+#include "vtkMultiProcessController.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
 #include "vtkPointSet.h"
@@ -24,8 +26,10 @@
 #include "vtkUnsignedCharArray.h"
 
 #include "Deformation/CageCoordinates.h"
+#include "SDFCageParallel.h"
 #include "SDFCageVTKConversion.h"
 
+#include <algorithm>
 #include <chrono>
 #include <exception>
 #include <new>
@@ -78,6 +82,43 @@ std::string ToCage(vtkPolyData* data, sdfcage::TriangleMesh& mesh)
   return {};
 }
 
+/// The same points (bit for bit) and the same polygons in the same order.
+bool SameSurface(vtkPolyData* a, vtkPolyData* b)
+{
+  if (a->GetNumberOfPoints() != b->GetNumberOfPoints() || a->GetNumberOfPolys() != b->GetNumberOfPolys() ||
+    a->GetNumberOfStrips() != b->GetNumberOfStrips())
+  {
+    return false;
+  }
+  double p[3];
+  double q[3];
+  for (vtkIdType i = 0; i < a->GetNumberOfPoints(); ++i)
+  {
+    a->GetPoint(i, p);
+    b->GetPoint(i, q);
+    if (p[0] != q[0] || p[1] != q[1] || p[2] != q[2])
+    {
+      return false;
+    }
+  }
+  vtkCellArray* ca = a->GetPolys();
+  vtkCellArray* cb = b->GetPolys();
+  vtkIdType na = 0;
+  vtkIdType nb = 0;
+  const vtkIdType* ia = nullptr;
+  const vtkIdType* ib = nullptr;
+  ca->InitTraversal();
+  cb->InitTraversal();
+  while (ca->GetNextCell(na, ia))
+  {
+    if (!cb->GetNextCell(nb, ib) || na != nb || !std::equal(ia, ia + na, ib))
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
 double SecondsSince(std::chrono::steady_clock::time_point start)
 {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -96,6 +137,7 @@ struct vtkCageDeformationFilter::vtkInternals
   vtkMTimeType RestTime = 0;
   int Coordinates = -1;
   bool Single = false;
+  vtkSmartPointer<vtkPolyData> JoinedRest; ///< under MPI: the joined rest cage the weights are for
   sdfcage::CageBindingResult Binding;
 };
 
@@ -167,6 +209,28 @@ int vtkCageDeformationFilter::RequestData(
   vtkPolyData* rest = vtkPolyData::GetData(inputVector[1], 0);
   vtkPolyData* deformed = vtkPolyData::GetData(inputVector[2], 0);
   vtkPointSet* output = vtkPointSet::GetData(outputVector, 0);
+
+  // Under MPI (the points handed out in pieces, as ParaView's data servers do) each process moves
+  // its own piece of the points: a point's motion depends on the cages only. So the cages (on
+  // process 0 when they come from SDF Cage, or in pieces from a reader) are joined on every
+  // process, and the points are never gathered. The joined rest cage is a new object each time:
+  // the one the weights were computed for is kept while its points and triangles stay the same,
+  // so that moving the cage re-applies without computing the weights again.
+  vtkMultiProcessController* controller = DistributingController(inputVector);
+  vtkSmartPointer<vtkPolyData> restWhole;
+  vtkSmartPointer<vtkPolyData> deformedWhole;
+  if (controller)
+  {
+    restWhole = JoinOnEveryProcess(controller, rest);
+    deformedWhole = JoinOnEveryProcess(controller, deformed);
+    if (this->Internals->JoinedRest && SameSurface(this->Internals->JoinedRest, restWhole))
+    {
+      restWhole = this->Internals->JoinedRest;
+    }
+    this->Internals->JoinedRest = restWhole;
+    rest = restWhole->GetNumberOfPoints() > 0 ? restWhole.Get() : nullptr;
+    deformed = deformedWhole->GetNumberOfPoints() > 0 ? deformedWhole.Get() : nullptr;
+  }
   if (!output)
   {
     vtkErrorMacro("The output data object is missing or of the wrong type.");
@@ -195,161 +259,204 @@ int vtkCageDeformationFilter::RequestData(
     return 1; // a valid (empty) output; the error is reported
   };
 
-  try
-  {
-    if (!input || !rest || !deformed || input->GetNumberOfPoints() == 0 || rest->GetNumberOfPoints() == 0)
+  // the weights and the moved points on this process's points (a lambda: under MPI the results are
+  // shared after it, whatever path it returns by)
+  auto deformLocally = [&]() -> int {
+    try
     {
-      output->Initialize();
-      this->StatusString = StatusIdentifier(sdfcage::Status::EmptyInput);
-      publish();
-      return 1;
-    }
+      if (!input || !rest || !deformed || input->GetNumberOfPoints() == 0 || rest->GetNumberOfPoints() == 0)
+      {
+        output->Initialize();
+        this->StatusString = StatusIdentifier(sdfcage::Status::EmptyInput);
+        publish();
+        return 1;
+      }
 
-    // the weights: computed again only when the points, the rest cage or the coordinates changed
-    vtkInternals& in = *this->Internals;
-    const bool current = in.Deformer.bound() && in.Input == input && in.InputTime == input->GetMTime() &&
-      in.Rest == rest && in.RestTime == rest->GetMTime() && in.Coordinates == this->Coordinates &&
-      in.Single == (this->SinglePrecisionWeights != 0);
-    if (!current)
-    {
-      in.Deformer.clear();
-      in.Input = nullptr;
-      const std::string problem = ToCage(rest, in.RestCage);
+      // the weights: computed again only when the points, the rest cage or the coordinates changed
+      vtkInternals& in = *this->Internals;
+      const bool current = in.Deformer.bound() && in.Input == input && in.InputTime == input->GetMTime() &&
+        in.Rest == rest && in.RestTime == rest->GetMTime() && in.Coordinates == this->Coordinates &&
+        in.Single == (this->SinglePrecisionWeights != 0);
+      if (!current)
+      {
+        in.Deformer.clear();
+        in.Input = nullptr;
+        const std::string problem = ToCage(rest, in.RestCage);
+        if (!problem.empty())
+        {
+          return fail(sdfcage::Status::InvalidInput, "The rest cage (input 1) cannot be used: " + problem + ".");
+        }
+        std::vector<sdfcage::Vec3> points(static_cast<std::size_t>(input->GetNumberOfPoints()));
+        double p[3];
+        for (vtkIdType i = 0; i < input->GetNumberOfPoints(); ++i)
+        {
+          input->GetPoint(i, p);
+          points[static_cast<std::size_t>(i)] = sdfcage::Vec3(p[0], p[1], p[2]);
+        }
+        sdfcage::CageCoordinateOptions options;
+        options.Kind = this->Coordinates == GREEN ? sdfcage::CageCoordinateKind::Green : sdfcage::CageCoordinateKind::MeanValue;
+        options.NumberOfThreads = this->NumberOfThreads;
+        options.SinglePrecision = this->SinglePrecisionWeights != 0;
+        FilterProgress progress(this);
+        this->UpdateProgress(0.0);
+        in.Binding = in.Deformer.bind(in.RestCage, points, options, &progress);
+        if (in.Binding.State != sdfcage::Status::Ok)
+        {
+          const sdfcage::Status state = in.Binding.State;
+          const std::string message = in.Binding.Message;
+          in.Deformer.clear();
+          if (state == sdfcage::Status::Cancelled)
+          {
+            output->Initialize();
+            this->StatusString = StatusIdentifier(state);
+            this->LastErrorMessage = "cancelled";
+            publish();
+            return 1;
+          }
+          return fail(state,
+            (state == sdfcage::Status::InvalidInput ? "The rest cage (input 1) cannot be used: " : "Cage coordinates failed: ") +
+              message + ".");
+        }
+        in.Input = input;
+        in.InputTime = input->GetMTime();
+        in.Rest = rest;
+        in.RestTime = rest->GetMTime();
+        in.Coordinates = this->Coordinates;
+        in.Single = options.SinglePrecision;
+        this->WeightsRecomputed = true;
+        this->PointsOutside = static_cast<vtkIdType>(in.Binding.PointsOutside);
+        this->PointsOnCage = static_cast<vtkIdType>(in.Binding.PointsOnCage);
+        this->WeightTime = in.Binding.WeightTime;
+        this->ReproductionError = in.Binding.ReproductionError;
+        this->CageWasFlipped = in.Binding.CageWasFlipped;
+        if (in.Binding.PointsOutside > 0 || in.Binding.PointsOnCage > 0)
+        {
+          vtkWarningMacro(<< in.Binding.PointsOutside << " of " << input->GetNumberOfPoints()
+                          << " points are outside the rest cage (winding number below 1/2) and "
+                          << in.Binding.PointsOnCage
+                          << " on it: they are moved with mean value coordinates extended outside the cage "
+                             "(exact for affine cage motions, an extrapolation otherwise"
+                          << (this->Coordinates == GREEN ? "; Green coordinates are defined inside only" : "")
+                          << "). Point array CageLocation marks them (1 outside, 2 on the cage). A cage from "
+                             "vtkSDFCageFilter encloses every point of its input.");
+        }
+      }
+
+      // the deformed cage must be the rest cage moved
+      sdfcage::TriangleMesh moved;
+      const std::string problem = ToCage(deformed, moved);
       if (!problem.empty())
       {
-        return fail(sdfcage::Status::InvalidInput, "The rest cage (input 1) cannot be used: " + problem + ".");
+        return fail(sdfcage::Status::InvalidInput, "The deformed cage (input 2) cannot be used: " + problem + ".");
       }
-      std::vector<sdfcage::Vec3> points(static_cast<std::size_t>(input->GetNumberOfPoints()));
-      double p[3];
+      if (moved.Points.size() != in.RestCage.Points.size() || moved.Triangles != in.RestCage.Triangles)
+      {
+        std::ostringstream why;
+        why << "The deformed cage (input 2) must be the rest cage (input 1) with moved points: same points and "
+               "triangles in the same order; it has "
+            << moved.Points.size() << " points and " << moved.Triangles.size() << " triangles, the rest cage "
+            << in.RestCage.Points.size() << " and " << in.RestCage.Triangles.size()
+            << (moved.Points.size() == in.RestCage.Points.size() && moved.Triangles.size() == in.RestCage.Triangles.size()
+                   ? " but other triangles"
+                   : "")
+            << ".";
+        return fail(sdfcage::Status::InvalidInput, why.str());
+      }
+      for (const sdfcage::Vec3& p : moved.Points)
+      {
+        if (!p.allFinite())
+        {
+          return fail(sdfcage::Status::InvalidInput, "The deformed cage (input 2) has NaN or infinite coordinates.");
+        }
+      }
+
+      const auto start = std::chrono::steady_clock::now();
+      std::vector<sdfcage::Vec3> result;
+      if (!in.Deformer.apply(moved.Points, result, this->NumberOfThreads))
+      {
+        return fail(sdfcage::Status::Failed, "Cage deformation failed: the weights do not match the cages.");
+      }
+      this->ApplyTime = SecondsSince(start);
+
+      output->CopyStructure(input);
+      output->GetPointData()->PassData(input->GetPointData());
+      output->GetCellData()->PassData(input->GetCellData());
+      output->GetFieldData()->PassData(input->GetFieldData());
+      vtkNew<vtkPoints> points;
+      points->SetDataType(input->GetPoints()->GetDataType());
+      points->SetNumberOfPoints(input->GetNumberOfPoints());
       for (vtkIdType i = 0; i < input->GetNumberOfPoints(); ++i)
       {
-        input->GetPoint(i, p);
-        points[static_cast<std::size_t>(i)] = sdfcage::Vec3(p[0], p[1], p[2]);
+        const sdfcage::Vec3& q = result[static_cast<std::size_t>(i)];
+        points->SetPoint(i, q.x(), q.y(), q.z());
       }
-      sdfcage::CageCoordinateOptions options;
-      options.Kind = this->Coordinates == GREEN ? sdfcage::CageCoordinateKind::Green : sdfcage::CageCoordinateKind::MeanValue;
-      options.NumberOfThreads = this->NumberOfThreads;
-      options.SinglePrecision = this->SinglePrecisionWeights != 0;
-      FilterProgress progress(this);
-      this->UpdateProgress(0.0);
-      in.Binding = in.Deformer.bind(in.RestCage, points, options, &progress);
-      if (in.Binding.State != sdfcage::Status::Ok)
+      output->SetPoints(points);
+      vtkNew<vtkUnsignedCharArray> where;
+      where->SetName("CageLocation");
+      where->SetNumberOfTuples(input->GetNumberOfPoints());
+      for (vtkIdType i = 0; i < input->GetNumberOfPoints(); ++i)
       {
-        const sdfcage::Status state = in.Binding.State;
-        const std::string message = in.Binding.Message;
-        in.Deformer.clear();
-        if (state == sdfcage::Status::Cancelled)
-        {
-          output->Initialize();
-          this->StatusString = StatusIdentifier(state);
-          this->LastErrorMessage = "cancelled";
-          publish();
-          return 1;
-        }
-        return fail(state,
-          (state == sdfcage::Status::InvalidInput ? "The rest cage (input 1) cannot be used: " : "Cage coordinates failed: ") +
-            message + ".");
+        where->SetValue(i, static_cast<unsigned char>(in.Deformer.location(static_cast<std::size_t>(i))));
       }
-      in.Input = input;
-      in.InputTime = input->GetMTime();
-      in.Rest = rest;
-      in.RestTime = rest->GetMTime();
-      in.Coordinates = this->Coordinates;
-      in.Single = options.SinglePrecision;
-      this->WeightsRecomputed = true;
-      this->PointsOutside = static_cast<vtkIdType>(in.Binding.PointsOutside);
-      this->PointsOnCage = static_cast<vtkIdType>(in.Binding.PointsOnCage);
-      this->WeightTime = in.Binding.WeightTime;
-      this->ReproductionError = in.Binding.ReproductionError;
-      this->CageWasFlipped = in.Binding.CageWasFlipped;
-      if (in.Binding.PointsOutside > 0 || in.Binding.PointsOnCage > 0)
-      {
-        vtkWarningMacro(<< in.Binding.PointsOutside << " of " << input->GetNumberOfPoints()
-                        << " points are outside the rest cage (winding number below 1/2) and "
-                        << in.Binding.PointsOnCage
-                        << " on it: they are moved with mean value coordinates extended outside the cage "
-                           "(exact for affine cage motions, an extrapolation otherwise"
-                        << (this->Coordinates == GREEN ? "; Green coordinates are defined inside only" : "")
-                        << "). Point array CageLocation marks them (1 outside, 2 on the cage). A cage from "
-                           "vtkSDFCageFilter encloses every point of its input.");
-      }
+      output->GetPointData()->AddArray(where);
+      publish();
+      this->UpdateProgress(1.0);
+      return 1;
     }
-
-    // the deformed cage must be the rest cage moved
-    sdfcage::TriangleMesh moved;
-    const std::string problem = ToCage(deformed, moved);
-    if (!problem.empty())
+    catch (const std::bad_alloc&)
     {
-      return fail(sdfcage::Status::InvalidInput, "The deformed cage (input 2) cannot be used: " + problem + ".");
+      this->Internals = std::make_unique<vtkInternals>();
+      return fail(sdfcage::Status::Failed, "Out of memory for the cage coordinates.");
     }
-    if (moved.Points.size() != in.RestCage.Points.size() || moved.Triangles != in.RestCage.Triangles)
+    catch (const std::exception& e)
     {
-      std::ostringstream why;
-      why << "The deformed cage (input 2) must be the rest cage (input 1) with moved points: same points and "
-             "triangles in the same order; it has "
-          << moved.Points.size() << " points and " << moved.Triangles.size() << " triangles, the rest cage "
-          << in.RestCage.Points.size() << " and " << in.RestCage.Triangles.size()
-          << (moved.Points.size() == in.RestCage.Points.size() && moved.Triangles.size() == in.RestCage.Triangles.size()
-                 ? " but other triangles"
-                 : "")
-          << ".";
-      return fail(sdfcage::Status::InvalidInput, why.str());
+      this->Internals = std::make_unique<vtkInternals>();
+      return fail(sdfcage::Status::Failed, std::string("Cage deformation failed: ") + e.what());
     }
-    for (const sdfcage::Vec3& p : moved.Points)
+    catch (...)
     {
-      if (!p.allFinite())
-      {
-        return fail(sdfcage::Status::InvalidInput, "The deformed cage (input 2) has NaN or infinite coordinates.");
-      }
+      this->Internals = std::make_unique<vtkInternals>();
+      return fail(sdfcage::Status::Failed, "Cage deformation failed with an unknown exception.");
     }
-
-    const auto start = std::chrono::steady_clock::now();
-    std::vector<sdfcage::Vec3> result;
-    if (!in.Deformer.apply(moved.Points, result, this->NumberOfThreads))
-    {
-      return fail(sdfcage::Status::Failed, "Cage deformation failed: the weights do not match the cages.");
-    }
-    this->ApplyTime = SecondsSince(start);
-
-    output->CopyStructure(input);
-    output->GetPointData()->PassData(input->GetPointData());
-    output->GetCellData()->PassData(input->GetCellData());
-    output->GetFieldData()->PassData(input->GetFieldData());
-    vtkNew<vtkPoints> points;
-    points->SetDataType(input->GetPoints()->GetDataType());
-    points->SetNumberOfPoints(input->GetNumberOfPoints());
-    for (vtkIdType i = 0; i < input->GetNumberOfPoints(); ++i)
-    {
-      const sdfcage::Vec3& q = result[static_cast<std::size_t>(i)];
-      points->SetPoint(i, q.x(), q.y(), q.z());
-    }
-    output->SetPoints(points);
-    vtkNew<vtkUnsignedCharArray> where;
-    where->SetName("CageLocation");
-    where->SetNumberOfTuples(input->GetNumberOfPoints());
-    for (vtkIdType i = 0; i < input->GetNumberOfPoints(); ++i)
-    {
-      where->SetValue(i, static_cast<unsigned char>(in.Deformer.location(static_cast<std::size_t>(i))));
-    }
-    output->GetPointData()->AddArray(where);
+  };
+  const int rc = deformLocally();
+  if (controller)
+  {
+    this->ShareResults(controller, input && input->GetNumberOfPoints() > 0);
     publish();
-    this->UpdateProgress(1.0);
-    return 1;
   }
-  catch (const std::bad_alloc&)
+  return rc;
+}
+
+//------------------------------------------------------------------------------
+// Under MPI every process moved its own piece of the points: each reports the whole run, the
+// counts of points outside and on the cage summed over the processes, the times the longest. A
+// process whose piece has no points reports Ok when another piece was deformed.
+void vtkCageDeformationFilter::ShareResults(vtkMultiProcessController* controller, bool hasPoints)
+{
+  const vtkInternals& in = *this->Internals;
+  const bool bound = in.Deformer.bound();
+  long long counts[2] = { bound ? static_cast<long long>(in.Binding.PointsOutside) : 0,
+    bound ? static_cast<long long>(in.Binding.PointsOnCage) : 0 };
+  long long sums[2] = { 0, 0 };
+  controller->AllReduce(counts, sums, 2, vtkCommunicator::SUM_OP);
+  double values[3] = { bound ? in.Binding.WeightTime : 0.0, this->ApplyTime,
+    bound ? in.Binding.ReproductionError : 0.0 };
+  double largest[3] = { 0.0, 0.0, 0.0 };
+  controller->AllReduce(values, largest, 3, vtkCommunicator::MAX_OP);
+  const std::string ok = StatusIdentifier(sdfcage::Status::Ok);
+  int flags[2] = { this->WeightsRecomputed ? 1 : 0, this->StatusString == ok ? 1 : 0 };
+  int any[2] = { 0, 0 };
+  controller->AllReduce(flags, any, 2, vtkCommunicator::MAX_OP);
+  this->PointsOutside = static_cast<vtkIdType>(sums[0]);
+  this->PointsOnCage = static_cast<vtkIdType>(sums[1]);
+  this->WeightTime = largest[0];
+  this->ApplyTime = largest[1];
+  this->ReproductionError = largest[2];
+  this->WeightsRecomputed = any[0] != 0;
+  if (!hasPoints && any[1] && this->StatusString == StatusIdentifier(sdfcage::Status::EmptyInput))
   {
-    this->Internals = std::make_unique<vtkInternals>();
-    return fail(sdfcage::Status::Failed, "Out of memory for the cage coordinates.");
-  }
-  catch (const std::exception& e)
-  {
-    this->Internals = std::make_unique<vtkInternals>();
-    return fail(sdfcage::Status::Failed, std::string("Cage deformation failed: ") + e.what());
-  }
-  catch (...)
-  {
-    this->Internals = std::make_unique<vtkInternals>();
-    return fail(sdfcage::Status::Failed, "Cage deformation failed with an unknown exception.");
+    this->StatusString = ok;
   }
 }
 

@@ -61,6 +61,8 @@
 #include <memory> // For the cached weights
 #include <string> // For the status strings
 
+class vtkMultiProcessController;
+
 class SDFCAGEFILTERS_EXPORT vtkCageDeformationFilter : public vtkPointSetAlgorithm
 {
 public:
@@ -167,6 +169,9 @@ protected:
 private:
   vtkCageDeformationFilter(const vtkCageDeformationFilter&) = delete;
   void operator=(const vtkCageDeformationFilter&) = delete;
+
+  // Under MPI: every process reports the whole run (counts summed, times the longest).
+  void ShareResults(vtkMultiProcessController* controller, bool hasPoints);
 
   // the cached weights and what they were computed for
   struct vtkInternals;

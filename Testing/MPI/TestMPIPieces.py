@@ -173,6 +173,44 @@ for n in LEVELS:
     Delete(level)
 Delete(nested)
 
+# --- 1c. cage deformation: each rank moves its own piece of the points -----------------------------
+# An affine motion of the cage is reproduced exactly by mean value coordinates: every point of the
+# distributed sphere must land where the same affine map puts it, on its own rank.
+def affine(x, s, t):
+    return [s[k] * x[k] + t[k] for k in range(3)]
+
+
+moved = Transform(Input=cage)
+moved.Transform.Scale = [1.2, 0.9, 1.1]
+moved.Transform.Translate = [0.3, -0.1, 0.2]
+deform = CageDeformation(Input=sphere, RestCage=cage, DeformedCage=moved, Coordinates="Mean Value")
+deform.UpdatePipeline()
+chk.check(deform.GetDataInformation().GetNumberOfPoints() == sphere.GetDataInformation().GetNumberOfPoints(),
+          "deformation: as many points over the ranks as the distributed sphere (%d, %d)"
+          % (deform.GetDataInformation().GetNumberOfPoints(), sphere.GetDataInformation().GetNumberOfPoints()))
+pieces_in = servermanager.Fetch(sphere)
+pieces_out = servermanager.Fetch(deform)
+worst = 0.0
+for i in range(pieces_in.GetNumberOfPoints()):
+    want = affine(pieces_in.GetPoint(i), [1.2, 0.9, 1.1], [0.3, -0.1, 0.2])
+    got = pieces_out.GetPoint(i)
+    worst = builtins.max(worst, builtins.max(abs(got[k] - want[k]) for k in range(3)))
+chk.check(pieces_out.GetNumberOfPoints() == pieces_in.GetNumberOfPoints() and worst < 1e-6,  # float points
+          "deformation: every point of every piece moved by the cage's affine map (largest error %.3g)" % worst)
+chk.check(field_value(pieces_out, "Status") == "Ok" and field_value(pieces_out, "PointsOutsideCage") == 0,
+          "deformation: Ok, no point outside the rest cage (%s, %s)"
+          % (field_value(pieces_out, "Status"), field_value(pieces_out, "PointsOutsideCage")))
+chk.check(field_value(pieces_out, "WeightsRecomputed") == 1, "deformation: the weights computed once")
+# moving the cage again re-applies with the same weights on every rank (the joined rest cage kept)
+moved.Transform.Translate = [0.0, 0.4, 0.0]
+deform.UpdatePipeline()
+again = servermanager.Fetch(deform)
+chk.check(field_value(again, "WeightsRecomputed") == 0,
+          "deformation: the cage moved again, the weights kept under MPI (WeightsRecomputed %s)"
+          % field_value(again, "WeightsRecomputed"))
+Delete(deform)
+Delete(moved)
+
 # --- 2. the quality and optimize filters on distributed inputs ------------------------------------
 quality = CageQuality(Input=cage, Source=sphere)
 quality.UpdatePipeline()
