@@ -46,6 +46,10 @@ constexpr int LineSearchTries = 8;
 constexpr double InitialStep = 0.25;
 // MIPS sweeps stop when the smallest angle has not grown for this many.
 constexpr int StallSweeps = 4;
+/// MIPS sweeps after a round's first relocate only the vertices within this many rings of a
+/// triangle with an angle below the target (the rest of the cage has had its full pass; this
+/// keeps a 500-vertex cage's later sweeps a fraction of the first one's cost).
+constexpr int ActiveRings = 2;
 // The spacing energy's sweeps stop when one lowers it by less than this fraction.
 constexpr double SpacingConvergence = 0.002;
 // The default clearance at the default isovalue (c / 4), for Clearance <= 0.
@@ -272,13 +276,15 @@ public:
   /// never reads a position another vertex of the batch writes (cage triangle boxes are updated
   /// between batches), so a batch gives the same result in any order and on any number of threads.
   /// Batches take the pending vertices in index order, deferring those that overlap.
-  bool relocationPass(OptimizeResult& r, double progressBegin, double progressEnd)
+  /// `only` (optional, one flag per vertex): relocate just the flagged vertices.
+  bool relocationPass(
+    OptimizeResult& r, double progressBegin, double progressEnd, const std::vector<char>* only = nullptr)
   {
     const int steps = std::max(1, Opt.DescentSteps);
     const double dh = std::max(0.0, Opt.BarrierDistance);
     std::vector<int> pending, next, batch;
     for (std::size_t v = 0; v < P.size(); ++v)
-      if (!VT[v].empty())
+      if (!VT[v].empty() && (!only || (*only)[v]))
         pending.push_back(static_cast<int>(v));
     const std::size_t total = pending.size();
     std::vector<double> reach(P.size(), 0.0);
@@ -1088,6 +1094,39 @@ public:
     return minimumAngleOf(P[t[0]], P[t[1]], P[t[2]]);
   }
 
+  /// Flags the vertices within `rings` rings of a triangle with an angle below `target`
+  /// (degrees); returns how many.
+  std::size_t markNearSmallAngles(double target, int rings, std::vector<char>& flags) const
+  {
+    flags.assign(P.size(), 0);
+    std::vector<int> front;
+    for (std::size_t f = 0; f < T.size(); ++f)
+      if (triangleMinimumAngle(static_cast<int>(f)) < target)
+        for (int v : T[f])
+          if (!flags[v])
+          {
+            flags[v] = 1;
+            front.push_back(v);
+          }
+    std::size_t count = front.size();
+    std::vector<int> grown;
+    for (int ring = 0; ring < rings && !front.empty(); ++ring)
+    {
+      grown.clear();
+      for (int v : front)
+        for (int f : VT[v])
+          for (int w : T[f])
+            if (!flags[w])
+            {
+              flags[w] = 1;
+              grown.push_back(w);
+            }
+      count += grown.size();
+      front.swap(grown);
+    }
+    return count;
+  }
+
   /// One pass over the triangles with an angle below the target, worst first: a flip of one of
   /// its edges that raises the pair's smallest angle (the longest edge first); else the shortest
   /// edge is collapsed
@@ -1568,6 +1607,7 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
   int stalled = 0;
   TriangleMesh best; // MIPS: the cage after the sweep with the largest smallest angle
   const bool repair = mipsMode && options.TargetMinimumAngle > 0;
+  std::vector<char> active; // the vertices a narrowed sweep relocates
   const std::clock_t cpu0 = std::clock();
   for (int it = 0; it < rounds && !cancelled; ++it)
   {
@@ -1579,7 +1619,11 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
       long long repairs = 0;
       stage("relocating cage vertices", b, b + 0.8 * (e - b));
       const auto t0 = std::chrono::steady_clock::now();
-      cancelled = !opt.relocationPass(r, 0.0, 1.0);
+      // MIPS with a target: after the round's first sweep, only around the small angles
+      const bool narrow = repair && sw > 0;
+      if (narrow)
+        opt.markNearSmallAngles(options.TargetMinimumAngle, ActiveRings, active);
+      cancelled = !opt.relocationPass(r, 0.0, 1.0, narrow ? &active : nullptr);
       r.RelocationSeconds += seconds(t0);
       if (!cancelled && options.EdgeFlips)
       {
