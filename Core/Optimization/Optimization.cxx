@@ -962,12 +962,9 @@ public:
         out[k] += w.Counts[k];
   }
 
-  // ---- edge flip of (a, b): 1 flipped, 0 not worth it / not allowed topologically, -1 vetoed
-  /// `byAngle`: the flip must raise the smaller of the pair's smallest angles instead of
-  /// lowering E_quality (the repair of caps).
-  int tryFlip(int a, int b, bool byAngle = false)
+  /// The triangles on edge (a, b): f1 = (a, b, c) and f2 = (b, a, d) (-1 where there is none).
+  void edgeTriangles(int a, int b, int& f1, int& f2, int& c, int& d) const
   {
-    int f1 = -1, f2 = -1, c = -1, d = -1;
     for (int f : VT[a])
     {
       const Triangle& t = T[f];
@@ -985,6 +982,15 @@ public:
         }
       }
     }
+  }
+
+  // ---- edge flip of (a, b): 1 flipped, 0 not worth it / not allowed topologically, -1 vetoed
+  /// `byAngle`: the flip must raise the smaller of the pair's smallest angles instead of
+  /// lowering E_quality (the repair of caps).
+  int tryFlip(int a, int b, bool byAngle = false)
+  {
+    int f1 = -1, f2 = -1, c = -1, d = -1;
+    edgeTriangles(a, b, f1, f2, c, d);
     if (f1 < 0 || f2 < 0 || c == d || VT[a].size() <= 3 || VT[b].size() <= 3)
       return 0;
     for (int f : VT[c]) // the new edge must not exist already (manifold)
@@ -1008,8 +1014,6 @@ public:
       if (!(after < before - 1e-12 * std::abs(before)))
         return 0;
     }
-    if (!withinBudget(P[c], P[a], P[d]) || !withinBudget(P[d], P[b], P[c]))
-      return -1;
     // the veto: both new triangles at least min(the floor, the worse old one), not flipped
     // against the old pair's mean normal, clear of the input and of the rest of the cage
     const double qBefore = std::min(triangleQuality(P[a], P[b], P[c]), triangleQuality(P[b], P[a], P[d]));
@@ -1031,7 +1035,7 @@ public:
     s.Replaced.begin(T.size());
     s.Replaced.insert(f1);
     s.Replaced.insert(f2);
-    if (FlipVeto.check(s) != LocalChangeVerdict::Accepted)
+    if (!changeAccepted(s))
       return -1;
     // the flip sweeps the tetrahedron (a, b, c, d): an input component wholly inside it (its
     // representative inside; none comes near the four faces) would end up outside the cage
@@ -1075,6 +1079,18 @@ public:
   bool withinBudget(const Vec3& a, const Vec3& b, const Vec3& c) const
   {
     return !(Budget > 0) || triangleWithin(Tree, a, b, c, Budget, FidelityDepth);
+  }
+
+  /// A flip's or a collapse's new triangles (s.Tris, replacing s.Replaced): the veto (shape,
+  /// fold, exact input clearance, self-intersection), then the Hausdorff budget.
+  bool changeAccepted(LocalChangeScratch& s) const
+  {
+    if (FlipVeto.check(s) != LocalChangeVerdict::Accepted)
+      return false;
+    for (const ChangedTriangle& nt : s.Tris)
+      if (!withinBudget(nt.Pts[0], nt.Pts[1], nt.Pts[2]))
+        return false;
+    return true;
   }
 
   /// The ring of v at p within the budget.
@@ -1214,23 +1230,7 @@ public:
   int tryCollapse(int a, int b)
   {
     int f1 = -1, f2 = -1, c = -1, d = -1;
-    for (int f : VT[a])
-    {
-      const Triangle& t = T[f];
-      for (int k = 0; k < 3; ++k)
-      {
-        if (t[k] == a && t[(k + 1) % 3] == b)
-        {
-          f1 = f;
-          c = t[(k + 2) % 3];
-        }
-        if (t[k] == b && t[(k + 1) % 3] == a)
-        {
-          f2 = f;
-          d = t[(k + 2) % 3];
-        }
-      }
-    }
+    edgeTriangles(a, b, f1, f2, c, d);
     if (f1 < 0 || f2 < 0 || c == d || VT[c].size() <= 3 || VT[d].size() <= 3)
       return 0;
     std::vector<int> na, nb;
@@ -1290,15 +1290,7 @@ public:
       s.Replaced.insert(f2);
       for (int f : changed)
         s.Replaced.insert(f);
-      if (FlipVeto.check(s) != LocalChangeVerdict::Accepted)
-      {
-        vetoed = true;
-        continue;
-      }
-      bool ok = true;
-      for (const ChangedTriangle& nt : s.Tris)
-        ok = ok && withinBudget(nt.Pts[0], nt.Pts[1], nt.Pts[2]);
-      if (!ok || sweepsComponent(s.Tris, changed, f1, f2))
+      if (!changeAccepted(s) || sweepsComponent(s.Tris, changed, f1, f2))
       {
         vetoed = true;
         continue;
