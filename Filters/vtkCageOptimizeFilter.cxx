@@ -47,6 +47,9 @@ vtkCageOptimizeFilter::vtkCageOptimizeFilter()
   this->BarrierDistance = defaults.BarrierDistance;
   this->NumberOfIterations = defaults.NumberOfIterations;
   this->EdgeFlips = defaults.EdgeFlips ? 1 : 0;
+  this->HausdorffFactor = defaults.HausdorffFactor;
+  this->TargetMinimumAngle = defaults.TargetMinimumAngle;
+  this->MaximumSweeps = defaults.MaximumSweeps;
   this->MinimumClearance = defaults.Clearance;
   this->Internals = std::make_unique<vtkInternals>();
   this->SetNumberOfInputPorts(2);
@@ -202,6 +205,9 @@ int vtkCageOptimizeFilter::Execute(vtkPolyData* cage, vtkPolyData* source, vtkIn
     options.BarrierDistance = this->BarrierDistance;
     options.NumberOfIterations = this->NumberOfIterations;
     options.EdgeFlips = this->EdgeFlips != 0;
+    options.HausdorffFactor = this->HausdorffFactor;
+    options.TargetMinimumAngle = this->TargetMinimumAngle;
+    options.MaximumSweeps = this->MaximumSweeps;
     options.Clearance = this->MinimumClearance;
 
     FilterProgress progress(this);
@@ -258,6 +264,9 @@ void vtkCageOptimizeFilter::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "BarrierDistance: " << this->BarrierDistance << "\n";
   os << indent << "NumberOfIterations: " << this->NumberOfIterations << "\n";
   os << indent << "EdgeFlips: " << (this->EdgeFlips ? "On" : "Off") << "\n";
+  os << indent << "HausdorffFactor: " << this->HausdorffFactor << "\n";
+  os << indent << "TargetMinimumAngle: " << this->TargetMinimumAngle << "\n";
+  os << indent << "MaximumSweeps: " << this->MaximumSweeps << "\n";
   os << indent << "MinimumClearance: " << this->MinimumClearance << "\n";
   os << indent << "Status: " << this->StatusString << "\n";
   os << indent << "LastErrorMessage: " << this->LastErrorMessage << "\n";

@@ -116,7 +116,8 @@ public:
 
   ///@{
   /**
-   * Rounds of one relocation pass (every vertex) followed by one flip pass. Default 1.
+   * Rounds of up to MaximumSweeps sweeps (a relocation pass, a flip pass and, MIPS, a needle
+   * repair pass). Default 1.
    */
   vtkSetClampMacro(NumberOfIterations, int, 0, 1000);
   vtkGetMacro(NumberOfIterations, int);
@@ -129,6 +130,25 @@ public:
   vtkSetMacro(EdgeFlips, vtkTypeBool);
   vtkGetMacro(EdgeFlips, vtkTypeBool);
   vtkBooleanMacro(EdgeFlips, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
+   * Keeping the MIPS-optimized cage tight (ignored by the spacing energy). HausdorffFactor: no
+   * move, flip or collapse may put a point of a changed triangle farther from the input than
+   * this times the given cage's one-sided Hausdorff distance cage -> input; 0 = no bound, else
+   * at least 1 (a value in (0, 1) is an InvalidInput error). Default 1.4. TargetMinimumAngle:
+   * the smallest triangle angle (degrees) the sweeps aim at; triangles below it are repaired
+   * (flips, needle collapses paired with an edge split, so the vertex count stays exact); 0 = no
+   * repair. Default 15. MaximumSweeps: sweeps (relocation, flips, repair) per round; a round
+   * stops earlier once no angle is below the target or the smallest angle stalls. Default 12.
+   */
+  vtkSetClampMacro(HausdorffFactor, double, 0.0, 1000.0);
+  vtkGetMacro(HausdorffFactor, double);
+  vtkSetClampMacro(TargetMinimumAngle, double, 0.0, 59.0);
+  vtkGetMacro(TargetMinimumAngle, double);
+  vtkSetClampMacro(MaximumSweeps, int, 1, 1000);
+  vtkGetMacro(MaximumSweeps, int);
   ///@}
 
   ///@{
@@ -196,6 +216,9 @@ protected:
   double BarrierDistance;
   int NumberOfIterations;
   vtkTypeBool EdgeFlips;
+  double HausdorffFactor;
+  double TargetMinimumAngle;
+  int MaximumSweeps;
   double MinimumClearance;
 
   // outcome of the last execution (the results are in Internals' table)

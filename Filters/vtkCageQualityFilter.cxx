@@ -10,6 +10,7 @@
 #include "vtkCellArray.h"
 #include "vtkCellArrayIterator.h"
 #include "vtkCellData.h"
+#include "vtkCompositeDataSet.h"
 #include "vtkDoubleArray.h"
 #include "vtkExecutive.h"
 #include "vtkFieldData.h"
@@ -17,12 +18,14 @@
 #include "vtkInformation.h"
 #include "vtkInformationVector.h"
 #include "vtkIntArray.h"
+#include "vtkMultiBlockDataSet.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
 #include "vtkSmartPointer.h"
+#include "vtkStreamingDemandDrivenPipeline.h"
 #include "vtkStringArray.h"
 
 #include "Quality/CageQuality.h"
@@ -185,7 +188,56 @@ vtkPolyData* vtkCageQualityFilter::GetSource()
 int vtkCageQualityFilter::FillInputPortInformation(int port, vtkInformation* info)
 {
   info->Set(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkPolyData");
-  (void)port;
+  if (port == 0)
+  {
+    info->Append(vtkAlgorithm::INPUT_REQUIRED_DATA_TYPE(), "vtkMultiBlockDataSet"); // nested levels
+  }
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+int vtkCageQualityFilter::FillOutputPortInformation(int, vtkInformation* info)
+{
+  // a vtkPolyData for a cage, a vtkMultiBlockDataSet for nested levels (RequestDataObject)
+  info->Set(vtkDataObject::DATA_TYPE_NAME(), "vtkDataObject");
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+vtkTypeBool vtkCageQualityFilter::ProcessRequest(
+  vtkInformation* request, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  if (request->Has(vtkDemandDrivenPipeline::REQUEST_DATA_OBJECT()))
+  {
+    return this->RequestDataObject(request, inputVector, outputVector);
+  }
+  return this->Superclass::ProcessRequest(request, inputVector, outputVector);
+}
+
+//------------------------------------------------------------------------------
+int vtkCageQualityFilter::RequestDataObject(
+  vtkInformation*, vtkInformationVector** inputVector, vtkInformationVector* outputVector)
+{
+  vtkInformation* outInfo = outputVector->GetInformationObject(0);
+  if (!outInfo)
+  {
+    return 0;
+  }
+  vtkDataObject* input = vtkDataObject::GetData(inputVector[0], 0);
+  vtkDataObject* output = outInfo->Get(vtkDataObject::DATA_OBJECT());
+  if (vtkMultiBlockDataSet::SafeDownCast(input))
+  {
+    if (!vtkMultiBlockDataSet::SafeDownCast(output))
+    {
+      vtkNew<vtkMultiBlockDataSet> levels;
+      outInfo->Set(vtkDataObject::DATA_OBJECT(), levels);
+    }
+  }
+  else if (!vtkPolyData::SafeDownCast(output))
+  {
+    vtkNew<vtkPolyData> cage;
+    outInfo->Set(vtkDataObject::DATA_OBJECT(), cage);
+  }
   return 1;
 }
 
@@ -209,6 +261,17 @@ int vtkCageQualityFilter::RequestUpdateExtent(
 int vtkCageQualityFilter::RequestData(
   vtkInformation* vtkNotUsed(request), vtkInformationVector** inputVector, vtkInformationVector* outputVector)
 {
+  if (auto* levels = vtkMultiBlockDataSet::GetData(inputVector[0], 0))
+  {
+    this->ResetResults();
+    auto* output = vtkMultiBlockDataSet::GetData(outputVector, 0);
+    if (!output)
+    {
+      vtkErrorMacro("The output data object is missing or of the wrong type.");
+      return 0;
+    }
+    return this->ExecuteLevels(levels, vtkPolyData::GetData(inputVector[1], 0), output);
+  }
   sdfcage_vtk::WholeSurfaceRun run;
   return sdfcage_vtk::RunOnWholeSurface(
     this, inputVector, outputVector, run,
@@ -230,6 +293,75 @@ int vtkCageQualityFilter::Execute(vtkPolyData* cage, vtkPolyData* mesh, vtkInfor
     vtkErrorMacro("The output data object is missing or of the wrong type.");
     return 0;
   }
+  return this->Judge(cage, mesh, output);
+}
+
+//------------------------------------------------------------------------------
+int vtkCageQualityFilter::ExecuteLevels(vtkMultiBlockDataSet* levels, vtkPolyData* mesh, vtkMultiBlockDataSet* output)
+{
+  output->Initialize();
+  const unsigned int n = levels->GetNumberOfBlocks();
+  for (unsigned int i = 0; i < n; ++i)
+  {
+    vtkDataObject* block = levels->GetBlock(i);
+    if (block && !vtkPolyData::SafeDownCast(block))
+    {
+      vtkErrorMacro("Nested levels: block " << i << " is a " << block->GetClassName()
+                                            << ", not a vtkPolyData (a cage level).");
+      return 0;
+    }
+  }
+  output->SetNumberOfBlocks(n);
+  vtkPolyData* inner = mesh;
+  std::string innerName = "input";
+  sdfcage::ResultTable chosen = this->Internals->Results; // the filter's results: see the header
+  bool failed = false;
+  for (unsigned int i = 0; i < n; ++i)
+  {
+    std::string name = "block_" + std::to_string(i);
+    if (levels->HasMetaData(i) && levels->GetMetaData(i)->Has(vtkCompositeDataSet::NAME()))
+    {
+      name = levels->GetMetaData(i)->Get(vtkCompositeDataSet::NAME());
+    }
+    output->GetMetaData(i)->Set(vtkCompositeDataSet::NAME(), name.c_str());
+    auto* level = vtkPolyData::SafeDownCast(levels->GetBlock(i));
+    vtkNew<vtkPolyData> judged;
+    this->ResetResults();
+    if (level && level->GetNumberOfCells() > 0)
+    {
+      if (!this->Judge(level, inner, judged))
+      {
+        output->Initialize();
+        this->ResetResults();
+        return 0;
+      }
+      if (this->GetAbortExecute())
+      {
+        output->Initialize();
+        this->ResetResults();
+        return 1;
+      }
+      vtkNew<vtkStringArray> against;
+      against->SetName("JudgedAgainst");
+      against->InsertNextValue(innerName);
+      judged->GetFieldData()->AddArray(against);
+      if (!failed)
+      {
+        chosen = this->Internals->Results;
+        failed = this->GetResultNumber("Encloses") == 0;
+      }
+      inner = level;
+      innerName = name;
+    }
+    output->SetBlock(i, judged);
+  }
+  this->Internals->Results = chosen;
+  return 1;
+}
+
+//------------------------------------------------------------------------------
+int vtkCageQualityFilter::Judge(vtkPolyData* cage, vtkPolyData* mesh, vtkPolyData* output)
+{
   output->Initialize();
   if (!cage || cage->GetNumberOfCells() == 0)
   {

@@ -48,9 +48,23 @@
  * QualityMessage says why. An empty cage gives an empty output; an empty input mesh gives the
  * cage with Encloses 0.
  *
+ * Nested cages: input 0 may also be a vtkMultiBlockDataSet of cage levels, innermost (finest)
+ * first, as vtkSDFCageFilter's "Nested Cages" port (3) gives them (blocks "cage_2000",
+ * "cage_500", ...). Then the output is a vtkMultiBlockDataSet with the same blocks and names
+ * (GetOutput() returns null: use GetOutputDataObject(0)), each block the level judged as above
+ * against the next level in: the first block against the mesh of input 1, every other block
+ * against the last non-empty block before it. Each block carries its own arrays and results
+ * field data, plus the string array `JudgedAgainst` ("input" or the inner block's name). The
+ * filter's results (the getters) are those of the first level that does not enclose the one
+ * inside it, else of the outermost level, so GetEncloses() is true only when every level
+ * encloses the next one in. An empty block (a level that was not reached) gives an empty block
+ * and is skipped as an inner level; a block that is not a vtkPolyData is an error (empty
+ * output).
+ *
  * Under MPI, when each process is given its piece of the cage and of the mesh, both are gathered
  * on process 0 and judged there (see vtkSDFCageFilter): process 0 outputs the serial result, the
- * others an empty output with the same results field data.
+ * others an empty output with the same results field data. A multiblock input is not gathered:
+ * each process judges the blocks it holds against its own piece of the mesh.
  *
  * @sa
  * vtkSDFCageFilter vtkDistancePolyDataFilter vtkMeshQuality
@@ -63,6 +77,8 @@
 #include "vtkPolyDataAlgorithm.h"
 
 #include <memory> // For the results table
+
+class vtkMultiBlockDataSet;
 #include <string> // For the message
 
 class SDFCAGEFILTERS_EXPORT vtkCageQualityFilter : public vtkPolyDataAlgorithm
@@ -137,6 +153,9 @@ protected:
   ~vtkCageQualityFilter() override;
 
   int FillInputPortInformation(int port, vtkInformation* info) override;
+  int FillOutputPortInformation(int port, vtkInformation* info) override;
+  vtkTypeBool ProcessRequest(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
+  int RequestDataObject(vtkInformation*, vtkInformationVector**, vtkInformationVector*);
   int RequestUpdateExtent(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
   int RequestData(vtkInformation*, vtkInformationVector**, vtkInformationVector*) override;
 
@@ -144,6 +163,10 @@ protected:
 
 private:
   int Execute(vtkPolyData* cage, vtkPolyData* mesh, vtkInformationVector* outputVector); // on the whole inputs
+  // judges `cage` against `mesh` into `output` (the results into Internals); 0 on an error
+  int Judge(vtkPolyData* cage, vtkPolyData* mesh, vtkPolyData* output);
+  // nested levels: each block against the one inside it, the first against `mesh`
+  int ExecuteLevels(vtkMultiBlockDataSet* levels, vtkPolyData* mesh, vtkMultiBlockDataSet* output);
   void ResetResults();
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;

@@ -80,6 +80,9 @@ vtkSDFCageFilter::vtkSDFCageFilter()
   this->BarrierDistance = cageDefaults.Optimization.BarrierDistance;
   this->NumberOfIterations = cageDefaults.Optimization.NumberOfIterations;
   this->EdgeFlips = cageDefaults.Optimization.EdgeFlips ? 1 : 0;
+  this->HausdorffFactor = cageDefaults.Optimization.HausdorffFactor;
+  this->TargetMinimumAngle = cageDefaults.Optimization.TargetMinimumAngle;
+  this->MaximumSweeps = cageDefaults.Optimization.MaximumSweeps;
 
   this->Internals = std::make_unique<vtkInternals>();
   this->SetNumberOfInputPorts(1);
@@ -195,6 +198,9 @@ sdfcage::CageOptions CageOptionsOf(vtkSDFCageFilter* f)
   options.Optimization.BarrierDistance = f->GetBarrierDistance();
   options.Optimization.NumberOfIterations = f->GetNumberOfIterations();
   options.Optimization.EdgeFlips = f->GetEdgeFlips() != 0;
+  options.Optimization.HausdorffFactor = f->GetHausdorffFactor();
+  options.Optimization.TargetMinimumAngle = f->GetTargetMinimumAngle();
+  options.Optimization.MaximumSweeps = f->GetMaximumSweeps();
   return options;
 }
 
@@ -587,6 +593,9 @@ void vtkSDFCageFilter::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "BarrierDistance: " << this->BarrierDistance << "\n";
   os << indent << "NumberOfIterations: " << this->NumberOfIterations << "\n";
   os << indent << "EdgeFlips: " << (this->EdgeFlips ? "On" : "Off") << "\n";
+  os << indent << "HausdorffFactor: " << this->HausdorffFactor << "\n";
+  os << indent << "TargetMinimumAngle: " << this->TargetMinimumAngle << "\n";
+  os << indent << "MaximumSweeps: " << this->MaximumSweeps << "\n";
   os << indent << "Status: " << this->StatusString << "\n";
   os << indent << "LastErrorMessage: " << this->LastErrorMessage << "\n";
   for (const sdfcage::ResultField& f : this->Internals->Results)

@@ -360,6 +360,12 @@ public:
   vtkSetMacro(EdgeFlips, vtkTypeBool);
   vtkGetMacro(EdgeFlips, vtkTypeBool);
   vtkBooleanMacro(EdgeFlips, vtkTypeBool);
+  vtkSetClampMacro(HausdorffFactor, double, 0.0, 1000.0);
+  vtkGetMacro(HausdorffFactor, double);
+  vtkSetClampMacro(TargetMinimumAngle, double, 0.0, 59.0);
+  vtkGetMacro(TargetMinimumAngle, double);
+  vtkSetClampMacro(MaximumSweeps, int, 1, 1000);
+  vtkGetMacro(MaximumSweeps, int);
   ///@}
 
   ///@{
@@ -467,6 +473,9 @@ protected:
   double BarrierDistance;
   int NumberOfIterations;
   vtkTypeBool EdgeFlips;
+  double HausdorffFactor;
+  double TargetMinimumAngle;
+  int MaximumSweeps;
   int SignMode = 0;
   std::vector<int> NestedVertexCounts;
 

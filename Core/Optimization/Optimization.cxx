@@ -46,6 +46,10 @@ constexpr int LineSearchTries = 8;
 constexpr double InitialStep = 0.25;
 // MIPS sweeps stop when the smallest angle has not grown for this many.
 constexpr int StallSweeps = 4;
+/// MIPS sweeps after a round's first relocate only the vertices within this many rings of a
+/// triangle with an angle below the target (the rest of the cage has had its full pass; this
+/// keeps a 500-vertex cage's later sweeps a fraction of the first one's cost).
+constexpr int ActiveRings = 2;
 // The spacing energy's sweeps stop when one lowers it by less than this fraction.
 constexpr double SpacingConvergence = 0.002;
 // The default clearance at the default isovalue (c / 4), for Clearance <= 0.
@@ -272,13 +276,15 @@ public:
   /// never reads a position another vertex of the batch writes (cage triangle boxes are updated
   /// between batches), so a batch gives the same result in any order and on any number of threads.
   /// Batches take the pending vertices in index order, deferring those that overlap.
-  bool relocationPass(OptimizeResult& r, double progressBegin, double progressEnd)
+  /// `only` (optional, one flag per vertex): relocate just the flagged vertices.
+  bool relocationPass(
+    OptimizeResult& r, double progressBegin, double progressEnd, const std::vector<char>* only = nullptr)
   {
     const int steps = std::max(1, Opt.DescentSteps);
     const double dh = std::max(0.0, Opt.BarrierDistance);
     std::vector<int> pending, next, batch;
     for (std::size_t v = 0; v < P.size(); ++v)
-      if (!VT[v].empty())
+      if (!VT[v].empty() && (!only || (*only)[v]))
         pending.push_back(static_cast<int>(v));
     const std::size_t total = pending.size();
     std::vector<double> reach(P.size(), 0.0);
@@ -956,12 +962,9 @@ public:
         out[k] += w.Counts[k];
   }
 
-  // ---- edge flip of (a, b): 1 flipped, 0 not worth it / not allowed topologically, -1 vetoed
-  /// `byAngle`: the flip must raise the smaller of the pair's smallest angles instead of
-  /// lowering E_quality (the repair of caps).
-  int tryFlip(int a, int b, bool byAngle = false)
+  /// The triangles on edge (a, b): f1 = (a, b, c) and f2 = (b, a, d) (-1 where there is none).
+  void edgeTriangles(int a, int b, int& f1, int& f2, int& c, int& d) const
   {
-    int f1 = -1, f2 = -1, c = -1, d = -1;
     for (int f : VT[a])
     {
       const Triangle& t = T[f];
@@ -979,6 +982,15 @@ public:
         }
       }
     }
+  }
+
+  // ---- edge flip of (a, b): 1 flipped, 0 not worth it / not allowed topologically, -1 vetoed
+  /// `byAngle`: the flip must raise the smaller of the pair's smallest angles instead of
+  /// lowering E_quality (the repair of caps).
+  int tryFlip(int a, int b, bool byAngle = false)
+  {
+    int f1 = -1, f2 = -1, c = -1, d = -1;
+    edgeTriangles(a, b, f1, f2, c, d);
     if (f1 < 0 || f2 < 0 || c == d || VT[a].size() <= 3 || VT[b].size() <= 3)
       return 0;
     for (int f : VT[c]) // the new edge must not exist already (manifold)
@@ -1002,8 +1014,6 @@ public:
       if (!(after < before - 1e-12 * std::abs(before)))
         return 0;
     }
-    if (!withinBudget(P[c], P[a], P[d]) || !withinBudget(P[d], P[b], P[c]))
-      return -1;
     // the veto: both new triangles at least min(the floor, the worse old one), not flipped
     // against the old pair's mean normal, clear of the input and of the rest of the cage
     const double qBefore = std::min(triangleQuality(P[a], P[b], P[c]), triangleQuality(P[b], P[a], P[d]));
@@ -1025,7 +1035,7 @@ public:
     s.Replaced.begin(T.size());
     s.Replaced.insert(f1);
     s.Replaced.insert(f2);
-    if (FlipVeto.check(s) != LocalChangeVerdict::Accepted)
+    if (!changeAccepted(s))
       return -1;
     // the flip sweeps the tetrahedron (a, b, c, d): an input component wholly inside it (its
     // representative inside; none comes near the four faces) would end up outside the cage
@@ -1071,6 +1081,18 @@ public:
     return !(Budget > 0) || triangleWithin(Tree, a, b, c, Budget, FidelityDepth);
   }
 
+  /// A flip's or a collapse's new triangles (s.Tris, replacing s.Replaced): the veto (shape,
+  /// fold, exact input clearance, self-intersection), then the Hausdorff budget.
+  bool changeAccepted(LocalChangeScratch& s) const
+  {
+    if (FlipVeto.check(s) != LocalChangeVerdict::Accepted)
+      return false;
+    for (const ChangedTriangle& nt : s.Tris)
+      if (!withinBudget(nt.Pts[0], nt.Pts[1], nt.Pts[2]))
+        return false;
+    return true;
+  }
+
   /// The ring of v at p within the budget.
   bool ringWithinBudget(const Local& L, const Vec3& p) const
   {
@@ -1086,6 +1108,39 @@ public:
   {
     const Triangle& t = T[f];
     return minimumAngleOf(P[t[0]], P[t[1]], P[t[2]]);
+  }
+
+  /// Flags the vertices within `rings` rings of a triangle with an angle below `target`
+  /// (degrees); returns how many.
+  std::size_t markNearSmallAngles(double target, int rings, std::vector<char>& flags) const
+  {
+    flags.assign(P.size(), 0);
+    std::vector<int> front;
+    for (std::size_t f = 0; f < T.size(); ++f)
+      if (triangleMinimumAngle(static_cast<int>(f)) < target)
+        for (int v : T[f])
+          if (!flags[v])
+          {
+            flags[v] = 1;
+            front.push_back(v);
+          }
+    std::size_t count = front.size();
+    std::vector<int> grown;
+    for (int ring = 0; ring < rings && !front.empty(); ++ring)
+    {
+      grown.clear();
+      for (int v : front)
+        for (int f : VT[v])
+          for (int w : T[f])
+            if (!flags[w])
+            {
+              flags[w] = 1;
+              grown.push_back(w);
+            }
+      count += grown.size();
+      front.swap(grown);
+    }
+    return count;
   }
 
   /// One pass over the triangles with an angle below the target, worst first: a flip of one of
@@ -1175,23 +1230,7 @@ public:
   int tryCollapse(int a, int b)
   {
     int f1 = -1, f2 = -1, c = -1, d = -1;
-    for (int f : VT[a])
-    {
-      const Triangle& t = T[f];
-      for (int k = 0; k < 3; ++k)
-      {
-        if (t[k] == a && t[(k + 1) % 3] == b)
-        {
-          f1 = f;
-          c = t[(k + 2) % 3];
-        }
-        if (t[k] == b && t[(k + 1) % 3] == a)
-        {
-          f2 = f;
-          d = t[(k + 2) % 3];
-        }
-      }
-    }
+    edgeTriangles(a, b, f1, f2, c, d);
     if (f1 < 0 || f2 < 0 || c == d || VT[c].size() <= 3 || VT[d].size() <= 3)
       return 0;
     std::vector<int> na, nb;
@@ -1251,15 +1290,7 @@ public:
       s.Replaced.insert(f2);
       for (int f : changed)
         s.Replaced.insert(f);
-      if (FlipVeto.check(s) != LocalChangeVerdict::Accepted)
-      {
-        vetoed = true;
-        continue;
-      }
-      bool ok = true;
-      for (const ChangedTriangle& nt : s.Tris)
-        ok = ok && withinBudget(nt.Pts[0], nt.Pts[1], nt.Pts[2]);
-      if (!ok || sweepsComponent(s.Tris, changed, f1, f2))
+      if (!changeAccepted(s) || sweepsComponent(s.Tris, changed, f1, f2))
       {
         vetoed = true;
         continue;
@@ -1568,6 +1599,7 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
   int stalled = 0;
   TriangleMesh best; // MIPS: the cage after the sweep with the largest smallest angle
   const bool repair = mipsMode && options.TargetMinimumAngle > 0;
+  std::vector<char> active; // the vertices a narrowed sweep relocates
   const std::clock_t cpu0 = std::clock();
   for (int it = 0; it < rounds && !cancelled; ++it)
   {
@@ -1579,7 +1611,11 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
       long long repairs = 0;
       stage("relocating cage vertices", b, b + 0.8 * (e - b));
       const auto t0 = std::chrono::steady_clock::now();
-      cancelled = !opt.relocationPass(r, 0.0, 1.0);
+      // MIPS with a target: after the round's first sweep, only around the small angles
+      const bool narrow = repair && sw > 0;
+      if (narrow)
+        opt.markNearSmallAngles(options.TargetMinimumAngle, ActiveRings, active);
+      cancelled = !opt.relocationPass(r, 0.0, 1.0, narrow ? &active : nullptr);
       r.RelocationSeconds += seconds(t0);
       if (!cancelled && options.EdgeFlips)
       {

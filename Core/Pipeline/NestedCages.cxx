@@ -3,11 +3,14 @@
 #include "Common/Progress.h"
 #include "Mesh/Validation.h"
 #include "Quality/Verification.h"
+#include "Spatial/Geometry.h"
+#include "Spatial/TriangleTree.h"
 
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <climits>
+#include <cmath>
 #include <cstdlib>
 #include <functional>
 #include <sstream>
@@ -67,6 +70,42 @@ int componentsOf(const TriangleMesh& mesh)
 {
   std::vector<int> component;
   return triangleComponents(mesh, component);
+}
+
+/// The smallest distance between two parts of `mesh` when it is below `limit` (exact triangle
+/// distances), else `limit` (also for a mesh of one part).
+double gapBetweenParts(const TriangleMesh& mesh, double limit)
+{
+  std::vector<int> component;
+  const int parts = triangleComponents(mesh, component);
+  double gap = limit;
+  for (int c = 0; c + 1 < parts; ++c)
+  {
+    // the triangles of part c against those of the later parts
+    TriangleMesh others;
+    others.Points = mesh.Points;
+    for (std::size_t f = 0; f < mesh.Triangles.size(); ++f)
+      if (component[f] > c)
+        others.Triangles.push_back(mesh.Triangles[f]);
+    const TriangleTree tree(others);
+    std::vector<int> near;
+    for (std::size_t f = 0; f < mesh.Triangles.size(); ++f)
+    {
+      if (component[f] != c)
+        continue;
+      const Triangle& t = mesh.Triangles[f];
+      const Vec3 a[3] = { mesh.Points[t[0]], mesh.Points[t[1]], mesh.Points[t[2]] };
+      near.clear();
+      tree.trianglesWithin(a, gap, near);
+      for (int g : near)
+      {
+        const Triangle& u = others.Triangles[g];
+        const Vec3 b[3] = { mesh.Points[u[0]], mesh.Points[u[1]], mesh.Points[u[2]] };
+        gap = std::min(gap, std::sqrt(triangleTriangleDistance2(a, b)));
+      }
+    }
+  }
+  return gap;
 }
 } // namespace
 
@@ -217,6 +256,24 @@ NestedCageResult generateNestedCages(
     level.CageGenus = genus(r.Cage);
     level.CageComponents = componentsOf(r.Cage);
     level.TopologyKept = inputClosed && level.CageGenus == inputGenus && level.CageComponents == inputComponents;
+    if (k > 0 && level.CageComponents < nested.Levels[k - 1].CageComponents)
+    {
+      // parts fused: say whether any enclosing cage could have kept them apart. Each part of this
+      // level keeps the clearance from the level inside, and two parts keep the self clearance
+      // from each other, so parts of the level inside closer than twice the clearance plus the
+      // self clearance cannot stay apart, whatever the vertex count.
+      const double clearance = r.Normalize.lengthToInput(r.ClearanceUsedRelative);
+      const double needed = 2.0 * clearance + clearance / 4;
+      const double gap = gapBetweenParts(nested.Levels[k - 1].Result.Cage, needed);
+      if (gap < needed)
+      {
+        std::ostringstream why;
+        why << "the parts of the level inside are " << gap << " apart (input units), less than twice the clearance "
+            << "plus the self clearance (" << needed
+            << "): no cage enclosing it with the clearance can keep them apart, whatever its vertex count";
+        level.Result.TopologyWarning += (level.Result.TopologyWarning.empty() ? "" : "; ") + why.str();
+      }
+    }
     level.Seconds = seconds(t0);
     const bool verified = level.VerifiedAgainstInside && level.VerifiedAgainstInput;
     const bool cancelled = progressCancelled(progress);

@@ -143,6 +143,9 @@ std::string toJson(const RunReport& r)
   key("Optimize") << jsonString(r.Optimize);
   key("TargetSpacing") << jsonNumber(r.TargetSpacing);
   key("NumberOfIterations") << r.NumberOfIterations;
+  key("HausdorffFactor") << jsonNumber(r.HausdorffFactor);
+  key("TargetMinimumAngle") << jsonNumber(r.TargetMinimumAngle);
+  key("MaximumSweeps") << r.MaximumSweeps;
   key("NumberOfThreads") << r.NumberOfThreads;
   key("UseActivePoints") << (r.UseActivePoints ? "true" : "false");
   key("ActiveRadius") << jsonNumber(r.ActiveRadius);
@@ -291,6 +294,7 @@ void printSummary(std::ostream& os, const RunReport& r)
   {
     os << "optimization: " << r.Optimize << " energy " << number(r.number("EnergyBefore")) << " -> "
        << number(r.number("EnergyAfter")) << ", " << r.NumberOfIterations << " iteration(s), "
+       << r.integer("NumberOfSweeps") << " sweep(s), "
        << seconds(r.number("OptimizationTime")) << "\n"
        << "              min angle " << number(r.number("MinimumAngleBefore")) << " -> "
        << number(r.number("MinimumAngleAfter")) << " deg, Hausdorff cage->input " << number(r.number("HausdorffBefore"))

@@ -55,6 +55,9 @@ struct RunReport
   std::string Sign = "auto";     ///< the inside rule asked for (SignMode has the one used)
   double TargetSpacing = 0.0;
   int NumberOfIterations = 0;
+  double HausdorffFactor = 0.0;
+  double TargetMinimumAngle = 0.0;
+  int MaximumSweeps = 0;
   int NumberOfThreads = 0;
   bool UseActivePoints = true;
   double ActiveRadius = 0.0;

@@ -3,6 +3,7 @@
 //   sdfcage [INPUT] [-o OUT] [-n N | -n N1,N2,...] [--iso C] [--voxel H] [--clearance D] [--adaptivity A]
 //           [--refinements N] [--sign auto|flood|winding|unsigned] [--no-active-points] [--active-radius R] [--geodesic-threshold L]
 //           [--alpha A] [--beta B] [--optimize none|mips|spacing] [--spacing H] [--iterations K]
+//           [--hausdorff-factor F] [--target-angle DEG] [--sweeps K]
 //           [--report FILE.json] [--screenshot FILE.png] [--threads N] [--quiet] [--verbose]
 //           [--help] [--version]
 //   sdfcage --check INPUT CAGE [--report FILE.json] [--quiet]
@@ -135,7 +136,15 @@ void printUsage(std::ostream& os)
         "      --optimize E        optimize the cage (paper 3.3): none (default), mips (well-shaped\n"
         "                          triangles) or spacing (the cage at distance H from the input)\n"
         "      --spacing H         target distance of --optimize spacing, default 0.05\n"
-        "      --iterations K      optimization rounds (relocation + edge flips), default 1\n"
+        "      --iterations K      optimization rounds (of up to --sweeps sweeps), default 1\n"
+        "      --hausdorff-factor F\n"
+        "                          mips: no change may move the cage farther from the input than F\n"
+        "                          times the plain cage's one-sided Hausdorff distance; 0 = no bound,\n"
+        "                          else >= 1; default 1.4\n"
+        "      --target-angle DEG  mips: the smallest triangle angle aimed at (needles below it are\n"
+        "                          repaired by flips and collapses); 0 = no repair; default 15\n"
+        "      --sweeps K          sweeps per round (relocation, flips, needle repair); a round ends\n"
+        "                          earlier once no angle is below the target; default 12\n"
         "      --report FILE.json  write the results as JSON\n"
         "      --screenshot FILE.png\n"
         "                          render input and cage offscreen to a PNG (needs an X server:\n"
@@ -184,6 +193,9 @@ struct Options
   std::string Sign = "auto";       ///< auto, flood, winding or unsigned
   double Spacing = -1.0;           ///< -1 = the filter's default
   int Iterations = -1;             ///< -1 = the filter's default
+  double HausdorffFactor = -1.0;   ///< -1 = the filter's default
+  double TargetAngle = -1.0;       ///< -1 = the filter's default
+  int Sweeps = -1;                 ///< -1 = the filter's default
   int Threads = 0;
   bool Quiet = false;
   bool Verbose = false; ///< every result after the summary
@@ -443,6 +455,18 @@ bool parseBuildOption(ArgumentCursor& a, Options& o, vtkSDFCageFilter* limits)
     o.Spacing = a.number(limits->GetTargetSpacingMinValue(), limits->GetTargetSpacingMaxValue());
   else if (arg == "--iterations")
     o.Iterations = a.integer(limits->GetNumberOfIterationsMinValue(), limits->GetNumberOfIterationsMaxValue());
+  else if (arg == "--hausdorff-factor")
+  {
+    o.HausdorffFactor = a.number(limits->GetHausdorffFactorMinValue(), limits->GetHausdorffFactorMaxValue());
+    if (o.HausdorffFactor > 0 && o.HausdorffFactor < 1)
+    {
+      throw UsageError{ "--hausdorff-factor expects 0 (no bound) or a factor >= 1" };
+    }
+  }
+  else if (arg == "--target-angle")
+    o.TargetAngle = a.number(limits->GetTargetMinimumAngleMinValue(), limits->GetTargetMinimumAngleMaxValue());
+  else if (arg == "--sweeps")
+    o.Sweeps = a.integer(limits->GetMaximumSweepsMinValue(), limits->GetMaximumSweepsMaxValue());
   else if (arg == "--threads")
     o.Threads = a.integer(limits->GetNumberOfThreadsMinValue(), limits->GetNumberOfThreadsMaxValue());
   else if (arg == "-v" || arg == "--verbose")
@@ -819,6 +843,12 @@ void configureFilter(vtkSDFCageFilter* filter, const Options& o, RunReport& r)
     filter->SetTargetSpacing(o.Spacing);
   if (o.Iterations >= 0)
     filter->SetNumberOfIterations(o.Iterations);
+  if (o.HausdorffFactor >= 0)
+    filter->SetHausdorffFactor(o.HausdorffFactor);
+  if (o.TargetAngle >= 0)
+    filter->SetTargetMinimumAngle(o.TargetAngle);
+  if (o.Sweeps >= 0)
+    filter->SetMaximumSweeps(o.Sweeps);
   filter->SetNumberOfThreads(o.Threads);
   filter->SetSignMode(o.Sign == "flood" ? 1 : o.Sign == "winding" ? 2 : o.Sign == "unsigned" ? 3 : 0);
 
@@ -830,6 +860,9 @@ void configureFilter(vtkSDFCageFilter* filter, const Options& o, RunReport& r)
   r.Optimize = o.Optimize;
   r.TargetSpacing = filter->GetTargetSpacing();
   r.NumberOfIterations = filter->GetNumberOfIterations();
+  r.HausdorffFactor = filter->GetHausdorffFactor();
+  r.TargetMinimumAngle = filter->GetTargetMinimumAngle();
+  r.MaximumSweeps = filter->GetMaximumSweeps();
   r.Adaptivity = filter->GetAdaptivity();
   r.TargetNumberOfVertices = o.Nested.empty() ? filter->GetTargetNumberOfVertices() : o.Nested.front();
   r.NestedCounts = o.Nested;

@@ -138,6 +138,7 @@ vtkSmartPointer<vtkPolyData> MakeSphere(double radius, int resolution);
 // Test cases (each returns 0, 1 or Skipped).
 int TestSphere(const Context&);
 int TestOptimizeFilter(const Context&);
+int TestOptimizeTightOptions(const Context&);
 int TestBuiltinShape(const Context&);
 int TestOpenInput(const Context&);
 int TestNoSurface(const Context&);

@@ -127,4 +127,80 @@ int TestOptimizeFilter(const Context&)
   return c.Result();
 }
 
+// The MIPS options that keep the cage tight (HausdorffFactor, TargetMinimumAngle, MaximumSweeps)
+// reach Core through both filters: their defaults are Core's and each changes what Core reports.
+int TestOptimizeTightOptions(const Context&)
+{
+  Checker c("OptimizeTightOptions");
+  vtkSmartPointer<vtkPolyData> sphere = MakeSphere(1.0, 24);
+  vtkNew<vtkSDFCageFilter> cager;
+  cager->SetInputData(sphere);
+  cager->SetTargetNumberOfVertices(150);
+  cager->Update();
+  vtkPolyData* cage = cager->GetOutput(0);
+  if (!c.Check(std::string(cager->GetStatusString()) == "Ok" && cage->GetNumberOfPoints() == 150,
+        "the cage to optimize was built"))
+  {
+    return c.Result();
+  }
+  const sdfcage::OptimizeOptions defaults;
+  vtkNew<vtkCageOptimizeFilter> filter;
+  c.Check(filter->GetHausdorffFactor() == defaults.HausdorffFactor, "HausdorffFactor default is Core's");
+  c.Check(filter->GetTargetMinimumAngle() == defaults.TargetMinimumAngle, "TargetMinimumAngle default is Core's");
+  c.Check(filter->GetMaximumSweeps() == defaults.MaximumSweeps, "MaximumSweeps default is Core's");
+  c.Check(cager->GetHausdorffFactor() == defaults.HausdorffFactor &&
+      cager->GetTargetMinimumAngle() == defaults.TargetMinimumAngle &&
+      cager->GetMaximumSweeps() == defaults.MaximumSweeps,
+    "vtkSDFCageFilter: the same defaults");
+  vtkNew<MessageRecorder> messages;
+  messages->Watch(filter);
+  messages->Watch(filter->GetExecutive());
+  filter->SetInputData(cage);
+  filter->SetSourceData(sphere);
+
+  // TargetMinimumAngle: the share of small angles is measured against it
+  filter->SetMaximumSweeps(1);
+  filter->SetTargetMinimumAngle(15);
+  filter->Update();
+  const double small15 = filter->GetResultNumber("SmallAnglesBefore");
+  c.Check(std::string(filter->GetStatusString()) == "Ok", std::string("target 15: ") + filter->GetStatusString());
+  c.Check(filter->GetResultNumber("NumberOfSweeps") == 1,
+    "MaximumSweeps 1: one sweep, got " + Str(filter->GetResultNumber("NumberOfSweeps")));
+  filter->SetTargetMinimumAngle(45);
+  filter->Update();
+  const double small45 = filter->GetResultNumber("SmallAnglesBefore");
+  c.Check(small45 > small15 && small45 > 0,
+    "TargetMinimumAngle reaches Core: angles below 45 deg " + Str(small45) + "% > below 15 deg " + Str(small15) + "%");
+  // MaximumSweeps: 45 deg is out of reach, so the round runs every sweep allowed
+  filter->SetMaximumSweeps(2);
+  filter->Update();
+  c.Check(filter->GetResultNumber("NumberOfSweeps") == 2,
+    "MaximumSweeps 2: two sweeps, got " + Str(filter->GetResultNumber("NumberOfSweeps")));
+  c.Check(filter->GetOutput()->GetNumberOfPoints() == 150 && !filter->GetReverted(), "the vertex count is kept");
+  // HausdorffFactor: Core rejects a factor in (0, 1), with a clear error and an empty output
+  messages->Clear();
+  filter->SetHausdorffFactor(0.5);
+  filter->Update();
+  c.Check(std::string(filter->GetStatusString()) == "InvalidInput",
+    std::string("HausdorffFactor 0.5 reaches Core: ") + filter->GetStatusString());
+  c.Check(messages->ErrorContains("HausdorffFactor"), "the error names HausdorffFactor");
+  c.Check(filter->GetOutput()->GetNumberOfPoints() == 0, "empty output on error");
+  filter->SetHausdorffFactor(0);
+  filter->Update();
+  c.Check(std::string(filter->GetStatusString()) == "Ok", "HausdorffFactor 0 (no bound) is accepted");
+
+  // the optimization step of vtkSDFCageFilter passes them too
+  cager->OptimizeOn();
+  cager->SetEnergyToMIPS();
+  cager->SetMaximumSweeps(1);
+  cager->SetTargetMinimumAngle(45);
+  cager->Update();
+  c.Check(std::string(cager->GetStatusString()) == "Ok", std::string("SDF cage + MIPS: ") + cager->GetStatusString());
+  c.Check(cager->GetResultNumber("NumberOfSweeps") == 1 && cager->GetResultNumber("SmallAnglesBefore") > small15,
+    "vtkSDFCageFilter: MaximumSweeps and TargetMinimumAngle reach Core (sweeps " +
+      Str(cager->GetResultNumber("NumberOfSweeps")) + ", below 45 deg " +
+      Str(cager->GetResultNumber("SmallAnglesBefore")) + "%)");
+  return c.Result();
+}
+
 } // namespace sdfcage_test

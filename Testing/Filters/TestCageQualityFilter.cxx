@@ -14,6 +14,8 @@
 #include "vtkDataArray.h"
 #include "vtkExecutive.h"
 #include "vtkFieldData.h"
+#include "vtkInformation.h"
+#include "vtkMultiBlockDataSet.h"
 #include "vtkPointData.h"
 #include "vtkPoints.h"
 #include "vtkPolyData.h"
@@ -21,6 +23,10 @@
 #include "vtkStringArray.h"
 #include "vtkStripper.h"
 #include "vtkTriangleFilter.h"
+
+#ifdef SDFCAGE_HAVE_EXACT
+#include "ExactCheck.h" // the independent CGAL referee (test-only)
+#endif
 
 #include <cmath>
 #include <functional>
@@ -299,6 +305,190 @@ int TestQualityMixedCells(const Context&)
   return c.Result();
 }
 
+/// A sphere and its nested cages (150 and 60 vertices) from vtkSDFCageFilter's port 3.
+struct NestedSetup
+{
+  vtkSmartPointer<vtkPolyData> Input = Sphere(2.0, 32);
+  vtkNew<vtkSDFCageFilter> Cager;
+  NestedSetup()
+  {
+    this->Cager->SetInputData(this->Input);
+    this->Cager->SetNumberOfNestedLevels(2);
+    this->Cager->SetNestedVertexCount(0, 60); // the order does not matter: finest first
+    this->Cager->SetNestedVertexCount(1, 150);
+    this->Cager->Update();
+  }
+  vtkMultiBlockDataSet* Levels() { return vtkMultiBlockDataSet::SafeDownCast(this->Cager->GetOutputDataObject(3)); }
+};
+
+std::string BlockName(vtkMultiBlockDataSet* levels, unsigned int i)
+{
+  return levels && i < levels->GetNumberOfBlocks() && levels->HasMetaData(i) &&
+      levels->GetMetaData(i)->Has(vtkCompositeDataSet::NAME())
+    ? levels->GetMetaData(i)->Get(vtkCompositeDataSet::NAME())
+    : std::string();
+}
+
+#ifdef SDFCAGE_HAVE_EXACT
+sdfcage::TriangleMesh ToMesh(vtkPolyData* data)
+{
+  sdfcage::TriangleMesh mesh;
+  double p[3];
+  for (vtkIdType i = 0; i < data->GetNumberOfPoints(); ++i)
+  {
+    data->GetPoint(i, p);
+    mesh.Points.emplace_back(p[0], p[1], p[2]);
+  }
+  vtkIdType npts = 0;
+  const vtkIdType* pts = nullptr;
+  vtkCellArray* polys = data->GetPolys();
+  for (polys->InitTraversal(); polys->GetNextCell(npts, pts);)
+  {
+    for (vtkIdType k = 1; k + 1 < npts; ++k)
+    {
+      mesh.Triangles.push_back({ static_cast<int>(pts[0]), static_cast<int>(pts[k]), static_cast<int>(pts[k + 1]) });
+    }
+  }
+  return mesh;
+}
+#endif
+
+// vtkSDFCageFilter's "Nested Cages" port: one block per level, finest first, named by its count,
+// with exactly that many vertices, each strictly enclosing the level inside it and the input
+// (judged by the exact CGAL referee when it is built).
+int TestNestedCagesPort(const Context&)
+{
+  Checker c("NestedCagesPort");
+  NestedSetup s;
+  vtkMultiBlockDataSet* levels = s.Levels();
+  if (!c.Check(levels != nullptr, "port 3 is a vtkMultiBlockDataSet"))
+  {
+    return c.Result();
+  }
+  c.Check(std::string(s.Cager->GetStatusString()) == "Ok", std::string("status ") + s.Cager->GetStatusString());
+  c.Check(levels->GetNumberOfBlocks() == 2, "two blocks, got " + Str(levels->GetNumberOfBlocks()));
+  const int counts[2] = { 150, 60 };
+  vtkPolyData* inner = s.Input;
+  for (unsigned int i = 0; i < levels->GetNumberOfBlocks() && i < 2; ++i)
+  {
+    const std::string expected = "cage_" + std::to_string(counts[i]);
+    c.Check(BlockName(levels, i) == expected, "block " + Str(i) + " named " + expected + ", got " + BlockName(levels, i));
+    auto* level = vtkPolyData::SafeDownCast(levels->GetBlock(i));
+    if (!c.Check(level != nullptr, "block " + Str(i) + " is a vtkPolyData"))
+    {
+      continue;
+    }
+    c.Check(level->GetNumberOfPoints() == counts[i],
+      expected + ": " + Str(level->GetNumberOfPoints()) + " vertices, asked " + Str(counts[i]));
+    c.Check(level->GetPointData()->GetArray("DistanceToInput") != nullptr, expected + ": DistanceToInput");
+#ifdef SDFCAGE_HAVE_EXACT
+    const sdfcage::TriangleMesh cage = ToMesh(level);
+    for (vtkPolyData* inside : { inner, static_cast<vtkPolyData*>(s.Input) })
+    {
+      const sdfcage::exact::ExactReport r = sdfcage::exact::exactCheck(ToMesh(inside), cage, 0.0);
+      c.Check(r.Encloses && r.MinimumClearance > 0,
+        expected + " strictly encloses " + (inside == s.Input ? std::string("the input") : BlockName(levels, i - 1)) +
+          " (exact referee, clearance " + Str(r.MinimumClearance) + ")");
+    }
+#endif
+    inner = level;
+  }
+  // the single-cage port holds the finest level
+  c.Check(s.Cager->GetOutput(0)->GetNumberOfPoints() == 150, "port 0 is the finest level");
+  return c.Result();
+}
+
+// vtkCageQualityFilter on the nested levels: each judged against the next one in, the innermost
+// against the input; a level judged against a level outside it is caught.
+int TestQualityNestedLevels(const Context&)
+{
+  Checker c("QualityNestedLevels");
+  NestedSetup s;
+  vtkMultiBlockDataSet* levels = s.Levels();
+  if (!c.Check(levels && levels->GetNumberOfBlocks() == 2, "two nested levels built"))
+  {
+    return c.Result();
+  }
+  vtkNew<vtkCageQualityFilter> quality;
+  vtkNew<MessageRecorder> messages;
+  messages->Watch(quality);
+  quality->SetInputConnection(s.Cager->GetOutputPort(3));
+  quality->SetSourceData(s.Input);
+  quality->Update();
+  auto* judged = vtkMultiBlockDataSet::SafeDownCast(quality->GetOutputDataObject(0));
+  c.Check(quality->GetOutput() == nullptr, "GetOutput() is null for levels (a multiblock)");
+  if (!c.Check(judged && judged->GetNumberOfBlocks() == 2, "the output has the two levels"))
+  {
+    return c.Result();
+  }
+  c.Check(quality->GetEncloses(), std::string("every level encloses the next one in: ") + quality->GetQualityMessage());
+  double clearanceToInner[2] = { 0, 0 };
+  for (unsigned int i = 0; i < 2; ++i)
+  {
+    auto* block = vtkPolyData::SafeDownCast(judged->GetBlock(i));
+    const std::string name = BlockName(judged, i);
+    c.Check(name == BlockName(levels, i), "block " + Str(i) + " keeps its name " + name);
+    auto* original = vtkPolyData::SafeDownCast(levels->GetBlock(i));
+    if (!c.Check(block && original && block->GetNumberOfPoints() == original->GetNumberOfPoints(),
+          name + ": the level with its points"))
+    {
+      continue;
+    }
+    auto* against = vtkStringArray::SafeDownCast(block->GetFieldData()->GetAbstractArray("JudgedAgainst"));
+    const std::string expected = i == 0 ? "input" : BlockName(levels, 0);
+    c.Check(against && against->GetValue(0) == expected, name + ": judged against " + expected);
+    c.Check(FieldValue(block, "Encloses") == 1, name + ": encloses the level inside it");
+    c.Check(block->GetPointData()->GetArray("DistanceToInput") != nullptr &&
+        block->GetCellData()->GetArray("MinimumAngle") != nullptr,
+      name + ": per-point and per-cell arrays");
+    clearanceToInner[i] = FieldValue(block, "MinimumClearance");
+  }
+  // the coarse level judged against the fine one, not the input: its clearance is the gap to
+  // the fine level, smaller than its gap to the input
+  vtkNew<vtkCageQualityFilter> single;
+  single->SetInputData(levels->GetBlock(1));
+  single->SetSourceData(s.Input);
+  single->Update();
+  c.Check(single->GetEncloses() && clearanceToInner[1] > 0 && clearanceToInner[1] < single->GetMinimumClearance(),
+    "the outer level's clearance is to the inner level (" + Str(clearanceToInner[1]) + " < " +
+      Str(single->GetMinimumClearance()) + " to the input)");
+  c.Check(std::abs(quality->GetMinimumClearance() - clearanceToInner[1]) <= 1e-12 * clearanceToInner[1],
+    "the filter's results are the outermost level's");
+  c.Check(messages->Errors.empty(), "no errors");
+
+  // the order reversed (coarse first): the fine level does not enclose the coarse one
+  vtkNew<vtkMultiBlockDataSet> reversed;
+  reversed->SetNumberOfBlocks(2);
+  reversed->SetBlock(0, levels->GetBlock(1));
+  reversed->SetBlock(1, levels->GetBlock(0));
+  quality->SetInputData(reversed);
+  quality->Update();
+  c.Check(!quality->GetEncloses(), "reversed levels: the fine level does not enclose the coarse one");
+  judged = vtkMultiBlockDataSet::SafeDownCast(quality->GetOutputDataObject(0));
+  c.Check(judged && BlockName(judged, 1) == "block_1", "unnamed blocks get block_<i>");
+
+  // a single level still gives a vtkPolyData
+  quality->SetInputData(levels->GetBlock(0));
+  quality->Update();
+  c.Check(quality->GetOutput() != nullptr && quality->GetOutput()->GetNumberOfPoints() == 150 &&
+      quality->GetEncloses(),
+    "a single level: a vtkPolyData judged against the input");
+
+  // a block that is not a surface: an error, empty output
+  vtkNew<vtkMultiBlockDataSet> bad;
+  bad->SetNumberOfBlocks(2);
+  bad->SetBlock(0, levels->GetBlock(0));
+  vtkNew<vtkMultiBlockDataSet> nestedBlock;
+  bad->SetBlock(1, nestedBlock);
+  quality->SetInputData(bad);
+  messages->Watch(quality->GetExecutive());
+  quality->Update();
+  judged = vtkMultiBlockDataSet::SafeDownCast(quality->GetOutputDataObject(0));
+  c.Check(messages->ErrorContains("not a vtkPolyData"), "a non-surface block is a clear error");
+  c.Check(judged && judged->GetNumberOfBlocks() == 0 && !quality->GetEncloses(), "empty output on error");
+  return c.Result();
+}
+
 int TestQualityAbort(const Context&)
 {
   Checker c("QualityAbort");
@@ -326,6 +516,8 @@ int main(int argc, char* argv[])
     { "QualityOfSDFCage", TestQualityOfSDFCage },
     { "QualityAbort", TestQualityAbort },
     { "QualityMixedCells", TestQualityMixedCells },
+    { "NestedCagesPort", TestNestedCagesPort },
+    { "QualityNestedLevels", TestQualityNestedLevels },
   };
   if (argc < 2 || cases.find(argv[1]) == cases.end())
   {

@@ -47,6 +47,7 @@ int main(int argc, char* argv[])
   const std::map<std::string, std::function<int(const Context&)>> cases = {
     { "Sphere", TestSphere },
     { "OptimizeFilter", TestOptimizeFilter },
+    { "OptimizeTightOptions", TestOptimizeTightOptions },
     { "BuiltinShape", TestBuiltinShape },
     { "OpenInput", TestOpenInput },
     { "NoSurface", TestNoSurface },

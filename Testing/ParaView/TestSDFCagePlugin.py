@@ -150,6 +150,20 @@ opt = CageOptimize(Input=cage, Source=sphere)
 check(opt.Energy == "MIPS", "Energy default MIPS (got %s)" % opt.Energy)
 check(abs(opt.TargetSpacing - 0.05) < 1e-12, "TargetSpacing default 0.05")
 check(opt.NumberOfIterations == 1 and opt.EdgeFlips == 1, "one iteration with edge flips by default")
+check(abs(opt.HausdorffFactor - 1.4) < 1e-12 and abs(opt.TargetMinimumAngle - 15) < 1e-12 and
+      opt.MaximumSweeps == 12, "MIPS defaults: Hausdorff factor 1.4, target angle 15, 12 sweeps")
+# the MIPS options reach the filter: one sweep, and the share of small angles measured at 45 deg
+opt.MaximumSweeps = 1
+opt.TargetMinimumAngle = 45
+opt.UpdatePipeline()
+fd = servermanager.Fetch(opt).GetFieldData()
+check(fd.GetArray("NumberOfSweeps").GetValue(0) == 1, "Maximum Sweeps 1: one sweep run")
+small45 = fd.GetArray("SmallAnglesBefore").GetValue(0)
+opt.TargetMinimumAngle = 15
+opt.UpdatePipeline()
+small15 = servermanager.Fetch(opt).GetFieldData().GetArray("SmallAnglesBefore").GetValue(0)
+check(small45 > small15, "Target Minimum Angle reaches the filter (%g%% below 45 > %g%% below 15)" % (small45, small15))
+opt.MaximumSweeps = 12
 for energy in ("MIPS", "Spacing"):
     opt.Energy = energy
     opt.TargetSpacing = 0.1

@@ -103,6 +103,24 @@ def test_levels():
         previous_to_input = to_input.GetMinimumClearance()
         inside = block
 
+    # the quality filter on the whole port 3: every level against the next one in, in one go
+    q = sdfcage.vtkCageQualityFilter()
+    q.SetInputConnection(f.GetOutputPort(3))
+    q.SetSourceData(mesh)
+    q.Update()
+    judged = q.GetOutputDataObject(0)
+    check(judged.IsA("vtkMultiBlockDataSet") and judged.GetNumberOfBlocks() == 3,
+          "the quality filter gives the three levels back")
+    check(q.GetEncloses(), "every level encloses the next one in (%s)" % q.GetQualityMessage())
+    for b, against in enumerate(("input", "cage_160", "cage_80")):
+        block = judged.GetBlock(b)
+        name = judged.GetMetaData(b).Get(vtk.vtkCompositeDataSet.NAME())
+        check(field(block, "JudgedAgainst") == against, "%s judged against %s" % (name, against))
+        clearance = field(levels.GetBlock(b), "ClearanceToInside")
+        check(field(block, "Encloses") == 1 and
+              abs(field(block, "MinimumClearance") - clearance) <= 1e-6 * clearance,
+              "%s: its clearance to the level inside, %g" % (name, clearance))
+
     # back to one cage: port 0 as before, port 3 empty
     f.SetNumberOfNestedLevels(0)
     f.SetTargetNumberOfVertices(100)
