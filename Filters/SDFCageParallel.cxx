@@ -470,7 +470,7 @@ vtkSmartPointer<vtkPolyData> JoinPieces(const std::vector<vtkPolyData*>& pieces,
 }
 
 //------------------------------------------------------------------------------
-vtkSmartPointer<vtkPolyData> JoinOnEveryProcess(vtkMultiProcessController* controller, vtkPolyData* piece)
+vtkSmartPointer<vtkPolyData> JoinOnProcessZero(vtkMultiProcessController* controller, vtkPolyData* piece)
 {
   vtkNew<vtkPolyData> send;
   if (piece)
@@ -479,16 +479,22 @@ vtkSmartPointer<vtkPolyData> JoinOnEveryProcess(vtkMultiProcessController* contr
   }
   std::vector<vtkSmartPointer<vtkDataObject>> received;
   controller->Gather(send, received, 0);
-  vtkSmartPointer<vtkPolyData> whole;
-  if (controller->GetLocalProcessId() == 0)
+  if (controller->GetLocalProcessId() != 0)
   {
-    std::vector<vtkPolyData*> pieces;
-    for (const auto& object : received)
-    {
-      pieces.push_back(vtkPolyData::SafeDownCast(object));
-    }
-    whole = JoinPieces(pieces);
+    return nullptr;
   }
+  std::vector<vtkPolyData*> pieces;
+  for (const auto& object : received)
+  {
+    pieces.push_back(vtkPolyData::SafeDownCast(object));
+  }
+  return JoinPieces(pieces);
+}
+
+//------------------------------------------------------------------------------
+vtkSmartPointer<vtkPolyData> JoinOnEveryProcess(vtkMultiProcessController* controller, vtkPolyData* piece)
+{
+  vtkSmartPointer<vtkPolyData> whole = JoinOnProcessZero(controller, piece);
   if (!whole)
   {
     whole = vtkSmartPointer<vtkPolyData>::New();
@@ -519,22 +525,11 @@ int RunOnWholeSurface(vtkAlgorithm* self, vtkInformationVector** inputVector, vt
   for (int p = 0; p < ports; ++p)
   {
     vtkPolyData* piece = InputOf(inputVector, p);
-    vtkNew<vtkPolyData> send;
-    if (piece)
-    {
-      send->ShallowCopy(piece);
-    }
-    std::vector<vtkSmartPointer<vtkDataObject>> received;
-    controller->Gather(send, received, 0);
+    vtkSmartPointer<vtkPolyData> joined = JoinOnProcessZero(controller, piece);
     if (root && piece)
     {
-      std::vector<vtkPolyData*> pieces;
-      for (const auto& object : received)
-      {
-        pieces.push_back(vtkPolyData::SafeDownCast(object));
-      }
-      whole[static_cast<std::size_t>(p)] = JoinPieces(pieces);
-      inputs[static_cast<std::size_t>(p)] = whole[static_cast<std::size_t>(p)];
+      whole[static_cast<std::size_t>(p)] = joined;
+      inputs[static_cast<std::size_t>(p)] = joined;
     }
   }
 

@@ -51,6 +51,11 @@ vtkMultiProcessController* DistributingController(vtkInformationVector** inputVe
 /// Null pieces are skipped. Exposed for tests.
 vtkSmartPointer<vtkPolyData> JoinPieces(const std::vector<vtkPolyData*>& pieces, vtkIdType* mergedPoints = nullptr);
 
+/// The whole of a surface handed out in pieces, on process 0 (collective): every process's piece
+/// gathered there and joined (JoinPieces); nullptr on the other processes. A null piece counts as
+/// empty.
+vtkSmartPointer<vtkPolyData> JoinOnProcessZero(vtkMultiProcessController* controller, vtkPolyData* piece);
+
 /// The whole of a surface handed out in pieces, on every process (collective): the pieces are
 /// gathered on process 0, joined (JoinPieces) and broadcast. A null piece counts as empty; the
 /// result is empty (never null) when every piece is.

@@ -19,6 +19,7 @@
 #include "vtkInformationVector.h"
 #include "vtkIntArray.h"
 #include "vtkMultiBlockDataSet.h"
+#include "vtkMultiProcessController.h"
 #include "vtkNew.h"
 #include "vtkObjectFactory.h"
 #include "vtkPointData.h"
@@ -270,7 +271,13 @@ int vtkCageQualityFilter::RequestData(
       vtkErrorMacro("The output data object is missing or of the wrong type.");
       return 0;
     }
-    return this->ExecuteLevels(levels, vtkPolyData::GetData(inputVector[1], 0), output);
+    vtkPolyData* mesh = vtkPolyData::GetData(inputVector[1], 0);
+    vtkMultiProcessController* controller = sdfcage_vtk::DistributingController(inputVector);
+    if (!controller)
+    {
+      return this->ExecuteLevels(levels, mesh, output);
+    }
+    return this->ExecuteLevelsDistributed(controller, levels, mesh, output);
   }
   sdfcage_vtk::WholeSurfaceRun run;
   return sdfcage_vtk::RunOnWholeSurface(
@@ -294,6 +301,63 @@ int vtkCageQualityFilter::Execute(vtkPolyData* cage, vtkPolyData* mesh, vtkInfor
     return 0;
   }
   return this->Judge(cage, mesh, output);
+}
+
+//------------------------------------------------------------------------------
+// Nested levels under MPI: the mesh's pieces and every level's pieces are joined on process 0,
+// judged there; the other processes output the same blocks, empty, and adopt process 0's return
+// code and results (collective: every process has the same number of blocks, as vtkSDFCageFilter
+// gives them).
+int vtkCageQualityFilter::ExecuteLevelsDistributed(
+  vtkMultiProcessController* controller, vtkMultiBlockDataSet* levels, vtkPolyData* mesh, vtkMultiBlockDataSet* output)
+{
+  const bool root = controller->GetLocalProcessId() == 0;
+  vtkSmartPointer<vtkPolyData> wholeMesh = sdfcage_vtk::JoinOnProcessZero(controller, mesh);
+  const unsigned int n = levels->GetNumberOfBlocks();
+  vtkNew<vtkMultiBlockDataSet> wholeLevels;
+  wholeLevels->SetNumberOfBlocks(n);
+  for (unsigned int i = 0; i < n; ++i)
+  {
+    vtkSmartPointer<vtkPolyData> level =
+      sdfcage_vtk::JoinOnProcessZero(controller, vtkPolyData::SafeDownCast(levels->GetBlock(i)));
+    wholeLevels->SetBlock(i, level);
+    if (levels->HasMetaData(i))
+    {
+      wholeLevels->GetMetaData(i)->Copy(levels->GetMetaData(i));
+    }
+  }
+  int rc = 1;
+  if (root)
+  {
+    rc = this->ExecuteLevels(wholeLevels, mesh ? wholeMesh.Get() : nullptr, output);
+  }
+  else
+  {
+    output->Initialize();
+    output->SetNumberOfBlocks(n);
+    for (unsigned int i = 0; i < n; ++i)
+    {
+      vtkNew<vtkPolyData> empty;
+      output->SetBlock(i, empty);
+      if (levels->HasMetaData(i))
+      {
+        output->GetMetaData(i)->Copy(levels->GetMetaData(i));
+      }
+    }
+  }
+  controller->Broadcast(&rc, 1, 0);
+  vtkNew<vtkPolyData> carrier; // process 0's results, for every process's getters
+  if (root)
+  {
+    sdfcage_vtk::AddResultArrays(carrier->GetFieldData(), this->Internals->Results);
+  }
+  controller->Broadcast(carrier, 0);
+  if (!root)
+  {
+    this->ResetResults();
+    sdfcage_vtk::ReadResultArrays(carrier->GetFieldData(), this->Internals->Results);
+  }
+  return rc;
 }
 
 //------------------------------------------------------------------------------

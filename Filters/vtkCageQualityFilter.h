@@ -63,8 +63,9 @@
  *
  * Under MPI, when each process is given its piece of the cage and of the mesh, both are gathered
  * on process 0 and judged there (see vtkSDFCageFilter): process 0 outputs the serial result, the
- * others an empty output with the same results field data. A multiblock input is not gathered:
- * each process judges the blocks it holds against its own piece of the mesh.
+ * others an empty output with the same results field data. Nested levels the same way: every
+ * level's pieces and the mesh's are joined on process 0 and judged there; the other processes
+ * output the same blocks, empty, and report process 0's results.
  *
  * @sa
  * vtkSDFCageFilter vtkDistancePolyDataFilter vtkMeshQuality
@@ -79,6 +80,7 @@
 #include <memory> // For the results table
 
 class vtkMultiBlockDataSet;
+class vtkMultiProcessController;
 #include <string> // For the message
 
 class SDFCAGEFILTERS_EXPORT vtkCageQualityFilter : public vtkPolyDataAlgorithm
@@ -167,6 +169,8 @@ private:
   int Judge(vtkPolyData* cage, vtkPolyData* mesh, vtkPolyData* output);
   // nested levels: each block against the one inside it, the first against `mesh`
   int ExecuteLevels(vtkMultiBlockDataSet* levels, vtkPolyData* mesh, vtkMultiBlockDataSet* output);
+  int ExecuteLevelsDistributed(vtkMultiProcessController* controller, vtkMultiBlockDataSet* levels, vtkPolyData* mesh,
+    vtkMultiBlockDataSet* output);
   void ResetResults();
   struct vtkInternals;
   std::unique_ptr<vtkInternals> Internals;

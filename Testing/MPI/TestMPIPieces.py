@@ -171,6 +171,25 @@ for n in LEVELS:
     chk.check(level.GetDataInformation().GetNumberOfPoints() == n,
               "Extract Block cage_%d: %d points over all ranks" % (n, level.GetDataInformation().GetNumberOfPoints()))
     Delete(level)
+# the quality filter on the whole nested output, the input mesh distributed too: each level judged
+# against the level inside it on rank 0, as in a serial run
+judge = CageQuality(Input=OutputPort(nested, 3), Source=sphere)
+judge.UpdatePipeline()
+judged = servermanager.Fetch(judge, 0)
+serial_judge = sdfcage.vtkCageQualityFilter()
+serial_judge.SetInputData(ref_levels)
+serial_judge.SetSourceData(whole)
+serial_judge.Update()
+serial_judged = serial_judge.GetOutputDataObject(0)
+for k, n in enumerate(LEVELS):
+    got, want = judged.GetBlock(k), serial_judged.GetBlock(k)
+    chk.check(got is not None and got.GetNumberOfPoints() == n and field_value(got, "Encloses") == 1
+              and field_value(got, "JudgedAgainst") == field_value(want, "JudgedAgainst")
+              and abs(field_value(got, "HausdorffCageToInput") - field_value(want, "HausdorffCageToInput"))
+              <= 1e-9 * want.GetLength(),
+              "quality of nested level cage_%d under MPI: encloses %s, judged against %s, as serial"
+              % (n, field_value(got, "Encloses") if got else None, field_value(got, "JudgedAgainst") if got else None))
+Delete(judge)
 Delete(nested)
 
 # --- 1c. cage deformation: each rank moves its own piece of the points -----------------------------
