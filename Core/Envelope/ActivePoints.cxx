@@ -876,9 +876,10 @@ ActivePoints computeActivePoints(const TriangleMesh& unitInput, const ActivePoin
   const std::size_t n = S.Points.size();
   result.Active.assign(n, 0);
   result.GeodesicToActive.assign(n, result.Cutoff);
-  progressUpdate(progress, 0.05);
-  if (unitInput.empty() || !options.validate().empty())
+  const bool cancelled = progressUpdate(progress, 0.05);
+  if (unitInput.empty() || !options.validate().empty() || cancelled)
   {
+    result.Cancelled = cancelled;
     result.Seconds = seconds(t0);
     return result;
   }

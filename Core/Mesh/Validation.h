@@ -84,6 +84,11 @@ struct ValidationOptions
 MeshDefects prepareMesh(const PolygonMesh& input, TriangleMesh& output,
   const ValidationOptions& options = ValidationOptions(), Progress* progress = nullptr);
 
+/// Genus of a closed 2-manifold triangle mesh (MeshDefects::closedManifold()) of `components`
+/// connected parts: every edge has two triangles, so E = 3F/2 and no edge list is sorted (the
+/// same value as Mesh.h's genus(), which works on any mesh, in a fraction of its time).
+int closedManifoldGenus(const TriangleMesh& mesh, int components);
+
 /// The same checks on a triangle mesh, without conversion or flipping (used to check envelopes
 /// and cages). Orientation is reported through InconsistentEdges only.
 MeshDefects checkTriangleMesh(const TriangleMesh& mesh);

@@ -1,5 +1,6 @@
 #include "Optimization/Optimization.h"
 
+#include "Common/GracePeriod.h"
 #include "Common/Progress.h"
 #include "Mesh/EdgeKey.h"
 #include "Mesh/Normalization.h"
@@ -328,6 +329,10 @@ public:
         tbb::blocked_range<std::size_t>(0, batch.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
           for (std::size_t i = range.begin(); i != range.end(); ++i)
           {
+            // after a cancel, the rest of the batch stays where it is (every move made was
+            // checked: the cage is valid); the next update() ends the pass
+            if (progressCancelled(Prog))
+              break;
             const int v = batch[i];
             for (int step = 0; step < steps; ++step)
             {
@@ -1518,8 +1523,18 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
   std::string why;
   double measured = 0.0;
   const auto tv = std::chrono::steady_clock::now();
-  if (!verifyEnclosure(
-        input, cage, std::numeric_limits<double>::min(), measured, why, nullptr, nullptr, true, &inputTree))
+  const bool givenOk =
+    verifyEnclosure(input, cage, std::numeric_limits<double>::min(), measured, why, nullptr, progress, true, &inputTree);
+  if (progressCancelled(progress))
+  {
+    // the given cage is not known to be valid: no cage (the pipeline keeps its own, verified)
+    r.State = Status::Cancelled;
+    r.Message = "cancelled while the given cage was verified: no cage";
+    r.Cage = TriangleMesh();
+    r.Seconds = seconds(start);
+    return r;
+  }
+  if (!givenOk)
   {
     r.State = Status::InvalidInput;
     r.Message = "the given cage does not enclose the input without self-intersection: " + why;
@@ -1640,11 +1655,24 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
     result = std::move(best);
   double clearance = 0.0;
   std::vector<double> dist;
-  if (verifyEnclosure(input, result, delta, clearance, why, &dist, nullptr, true, &inputTree))
+  // after a cancel (before or during it) it gets VerificationGrace seconds
+  GracePeriod grace(progress, VerificationGrace);
+  if (verifyEnclosure(input, result, delta, clearance, why, &dist, progress ? &grace : nullptr, true, &inputTree))
   {
     r.Cage = std::move(result);
     r.MinimumClearance = clearance;
     r.DistanceToInput = std::move(dist);
+  }
+  else if (grace.expired())
+  {
+    // cancelled, and the optimized cage could not be verified in time: the given cage (verified
+    // above; its distances are not measured again)
+    cancelled = true;
+    r.Reverted = true;
+    r.Message = "cancelled during optimization; the optimized cage could not be verified in time: the given cage "
+                "is returned unchanged";
+    r.Cage = cage;
+    r.MinimumClearance = measured;
   }
   else
   {
