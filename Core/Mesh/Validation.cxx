@@ -595,7 +595,8 @@ MeshDefects prepareMesh(
           edges.push_back(std::min(u, v) << 32 | std::max(u, v));
       }
     }
-    if (!cancellableSort(edges, progress) || cancelled())
+    cancellableSort(edges, progress); // false only when cancelled: cancelled() then clears the output
+    if (cancelled())
       return d;
     std::vector<char> onBoundary(np, 0);
     bool any = false;
@@ -718,7 +719,8 @@ MeshDefects prepareMesh(
       std::sort(k.begin(), k.end());
       sorted[f] = { k, static_cast<int>(f) };
     }
-    if (!cancellableSort(sorted, progress) || cancelled())
+    cancellableSort(sorted, progress);
+    if (cancelled())
       return d;
     std::vector<char> duplicate(kept.size(), 0);
     for (std::size_t i = 1; i < sorted.size(); ++i)
@@ -752,7 +754,8 @@ MeshDefects prepareMesh(
   if (cancelled())
     return d;
   // 3. topology
-  if (!checkTopology(output, d, progress) || cancelled())
+  checkTopology(output, d, progress);
+  if (cancelled())
     return d;
   std::vector<int> comp;
   d.Components = triangleComponents(output, comp);

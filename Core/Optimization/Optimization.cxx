@@ -1432,14 +1432,20 @@ private:
 /// One-sided Hausdorff distance cage -> input by branch and bound (the largest value reached;
 /// the bound is at most 1/32 of the largest triangle's size above it), and the fraction of
 /// triangle angles below `angle` degrees.
-double sampledHausdorff(const TriangleMesh& cage, const TriangleTree& tree)
+/// Once `progress` is cancelled it stops, with a lower bound of the distance.
+double sampledHausdorff(const TriangleMesh& cage, const TriangleTree& tree, Progress* progress = nullptr)
 {
   double lower = 0.0, upper = 0.0;
   for (const Triangle& t : cage.Triangles)
     for (int v : t)
       lower = std::max(lower, tree.distance(cage.Points[v]));
-  for (const Triangle& t : cage.Triangles)
+  for (std::size_t f = 0; f < cage.Triangles.size(); ++f)
+  {
+    if (f % 16 == 0 && progressCancelled(progress))
+      break;
+    const Triangle& t = cage.Triangles[f];
     triangleFarthest(tree, cage.Points[t[0]], cage.Points[t[1]], cage.Points[t[2]], FidelityDepth, lower, upper);
+  }
   return lower;
 }
 double smallAngleFraction(const TriangleMesh& cage, double angle)
@@ -1556,7 +1562,17 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
   r.MinimumAngleBefore = minimumAngle(cage);
   const bool mipsMode = options.Energy == CageEnergy::MIPS;
   r.SmallAnglesBefore = smallAngleFraction(cage, options.TargetMinimumAngle);
-  r.HausdorffBefore = sampledHausdorff(cage, inputTree);
+  r.HausdorffBefore = sampledHausdorff(cage, inputTree, progress);
+  if (progressCancelled(progress))
+  {
+    // the given cage, verified above (its distances are not measured again)
+    r.State = Status::Cancelled;
+    r.Reverted = true;
+    r.Message = "cancelled before the optimization: the given cage is returned unchanged";
+    r.MinimumClearance = measured;
+    r.Seconds = seconds(start);
+    return r;
+  }
   r.VerificationSeconds = seconds(tv);
 
   Optimizer opt(cage, input, inputTree, options, delta, selfDelta, progress);
@@ -1688,7 +1704,10 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
   r.EnergyAfter = cageEnergy(r.Cage, inputTree, options);
   r.MinimumAngleAfter = minimumAngle(r.Cage);
   r.SmallAnglesAfter = smallAngleFraction(r.Cage, options.TargetMinimumAngle);
-  r.HausdorffAfter = sampledHausdorff(r.Cage, inputTree);
+  // after a cancel, bounded by the verification's grace (then a lower bound)
+  r.HausdorffAfter = sampledHausdorff(r.Cage, inputTree, progress ? &grace : nullptr);
+  if (progress && grace.expired() && r.Message.find("lower bound") == std::string::npos)
+    r.Message += std::string(r.Message.empty() ? "" : "; ") + "HausdorffAfter is a lower bound (cut short by the cancel)";
   r.State = cancelled ? Status::Cancelled : Status::Ok;
   if (cancelled && r.Message.empty())
     r.Message = "cancelled during optimization; the cage so far is valid";

@@ -16,6 +16,7 @@
 #include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <cstdio>
 #include <cstdint>
 #include <limits>
 #include <random>
@@ -63,6 +64,24 @@ protected:
 private:
   std::string Stage;
   long long At;
+};
+
+/// Cancels in stage `Stage` once the run's overall progress reaches `At`.
+class CancelPast : public Progress
+{
+public:
+  CancelPast(std::string stage, double at)
+    : Stage(std::move(stage))
+    , At(at)
+  {
+  }
+
+protected:
+  bool pollCancel() override { return this->stageName() == Stage && this->overall() >= At; }
+
+private:
+  std::string Stage;
+  double At;
 };
 
 /// A closed sphere of some 160,000 triangles: several chunks of every cancellable sort.
@@ -200,19 +219,23 @@ TEST(CancelSimplification, OutputsNothingOrAVerifiedCage)
   const TriangleMesh input = makeBuiltinShape();
   const CageOptions options;
   int withCage = 0;
-  for (const long long at : { 1LL, 20LL, 100LL, 200LL })
+  // the simplification covers [0.45, 0.95] of the run: at its start (the whole envelope, 43,000
+  // vertices: too large to verify in the 0.15 s a cancel leaves, no cage), then late
+  for (const double at : { 0.45, 0.94, 0.945 })
   {
-    CancelInStage progress("simplifying", at);
+    CancelPast progress("simplifying", at);
     const CageResult r = generateCage(PolygonMesh::fromTriangles(input), options, &progress);
-    EXPECT_EQ(r.State, Status::Cancelled) << "at poll " << at << ": " << statusName(r.State) << ": " << r.Message;
+    EXPECT_EQ(r.State, Status::Cancelled) << "at " << at << ": " << statusName(r.State) << ": " << r.Message;
+    std::printf("cancel at %.3f of the run (simplifying): %s, %zu cage vertices (%d reached), %s\n", at,
+      statusName(r.State), r.Cage.Points.size(), r.VerticesReached, r.Message.c_str());
     if (r.Cage.empty())
       continue;
     ++withCage;
-    EXPECT_TRUE(r.EnclosureVerified);
+    EXPECT_EQ(static_cast<int>(r.Cage.Points.size()), r.VerticesReached);
     const exact::ExactReport report = exact::exactCheck(input, r.Cage, 0.0);
-    EXPECT_TRUE(report.Encloses) << "cancel at poll " << at << " of the simplification: " << r.Message;
+    EXPECT_TRUE(report.Encloses) << "cancel at " << at << " of the run: " << r.Message;
   }
-  // a cancel early in the simplification leaves a large cage; verifying it is given 0.15 s,
-  // which a small shape's cage needs far less than: some tries output their cage
+  // late cancels leave cages of a few hundred vertices more than the target, verified well
+  // within the grace: they are output
   EXPECT_GT(withCage, 0);
 }
