@@ -4,8 +4,10 @@
 #include "Common/CancellableSort.h"
 #include "Common/GracePeriod.h"
 #include "Common/Progress.h"
+#include "Envelope/ActivePoints.h"
 #include "ExactCheck.h"
 #include "Mesh/Mesh.h"
+#include "Mesh/Normalization.h"
 #include "Mesh/Shapes.h"
 #include "Mesh/Validation.h"
 #include "Pipeline/CageGenerator.h"
@@ -238,4 +240,23 @@ TEST(CancelSimplification, OutputsNothingOrAVerifiedCage)
   // late cancels leave cages of a few hundred vertices more than the target, verified well
   // within the grace: they are output
   EXPECT_GT(withCage, 0);
+}
+
+TEST(CancelActivePoints, StopsInsideTheEdgeGraphAndTheSampling)
+{
+  const TriangleMesh sphere = largeSphere();
+  const TriangleMesh unit = Normalization::fit(sphere).toUnit(sphere);
+  CancelAtPoll never;
+  const ActivePoints full = computeActivePoints(unit, ActivePointOptions(), &never);
+  ASSERT_FALSE(full.Cancelled);
+  const long long polls = never.Polls.load();
+  // the edge graph's sort (chunks of 65,536 of the refined surface's 3 x 160,000 edges) and the
+  // sampling (every 8,192 points) check too, not only the steps between them
+  EXPECT_GT(polls, 15);
+  for (const long long at : { 2LL, 4LL, polls / 3, polls / 2 })
+  {
+    CancelAtPoll progress(at);
+    const ActivePoints cut = computeActivePoints(unit, ActivePointOptions(), &progress);
+    EXPECT_TRUE(cut.Cancelled) << "cancel at poll " << at << " of " << polls;
+  }
 }
