@@ -79,8 +79,10 @@ struct ValidationOptions
 /// drops degenerate and duplicated triangles and unreferenced points, ignores vertex/line cells,
 /// measures closedness, manifoldness and orientation consistency, and flips a closed
 /// inward-oriented mesh. `output` is valid when the returned defects are usableAsInput().
-/// With `progress`, cancel checks between its steps: once cancelled it returns at the next one
-/// with `output` empty (the caller tells a cancel by progress->cancelled(), not by the defects).
+/// With `progress`, cancel checks between its steps and inside them (every 65,536 cells,
+/// triangles or vertices of a loop, every chunk of a sort: CancellableSort.h): once cancelled it
+/// returns at the next one with `output` empty (the caller tells a cancel by
+/// progress->cancelled(), not by the defects).
 MeshDefects prepareMesh(const PolygonMesh& input, TriangleMesh& output,
   const ValidationOptions& options = ValidationOptions(), Progress* progress = nullptr);
 

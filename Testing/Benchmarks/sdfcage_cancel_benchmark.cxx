@@ -16,8 +16,9 @@
 // a broken one makes the program exit with 1. A benchmark (prints figures), not a timed test.
 //
 //   sdfcage_cancel_benchmark [MESH] [--per-stage K] [--threads T] [--vertices V] [--iso C]
-//                            [--optimize] [--builtin] [--no-check]
-//   (default MESH: SDFCAGE_DATA_DIR/armadillo_midsub4x.obj, K = 3)
+//                            [--optimize] [--builtin] [--no-check] [--only TEXT]...
+//   (default MESH: SDFCAGE_DATA_DIR/armadillo_midsub4x.obj, K = 3; --only: tries in the stages
+//   whose progress text contains TEXT only, e.g. --only validating --only "active points")
 #include "vtkSDFCageFilter.h"
 
 #include "MeshIO.h"
@@ -104,6 +105,7 @@ struct Options
   double IsoValue = -1.0;
   bool Optimize = false;
   bool Check = true;
+  std::vector<std::string> Only; ///< tries only in the stages whose text contains one of these
 };
 
 /// What one run saw: the progress texts with their times, and (for a cancelled run) the time of
@@ -224,10 +226,12 @@ int main(int argc, char* argv[])
       o.Builtin = true;
     else if (a == "--no-check")
       o.Check = false;
+    else if (a == "--only")
+      o.Only.push_back(next());
     else if (a == "-h" || a == "--help")
     {
       std::printf("usage: sdfcage_cancel_benchmark [MESH] [--per-stage K] [--threads T] [--vertices V] [--iso C] "
-                  "[--optimize] [--builtin] [--no-check]\n");
+                  "[--optimize] [--builtin] [--no-check] [--only TEXT]...\n");
       return 0;
     }
     else if (!a.empty() && a[0] == '-')
@@ -281,7 +285,9 @@ int main(int argc, char* argv[])
       const std::string& text = record.Texts[k].second;
       const bool seen = std::any_of(
         stages.begin(), stages.end(), [&text](const std::pair<std::string, double>& s) { return s.first == text; });
-      if (!text.empty() && !seen)
+      const bool wanted = o.Only.empty() ||
+        std::any_of(o.Only.begin(), o.Only.end(), [&text](const std::string& w) { return text.find(w) != std::string::npos; });
+      if (!text.empty() && !seen && wanted)
         stages.emplace_back(text, end - record.Texts[k].first);
     }
     std::printf("longest time between progress events (the filter's Abort is polled there), per stage:\n");
