@@ -260,3 +260,47 @@ TEST(CancelActivePoints, StopsInsideTheEdgeGraphAndTheSampling)
     EXPECT_TRUE(cut.Cancelled) << "cancel at poll " << at << " of " << polls;
   }
 }
+
+namespace
+{
+/// Cancels at the `At`-th poll made in stage `Stage` once the overall progress reached `From`.
+class CancelAfter : public Progress
+{
+public:
+  CancelAfter(std::string stage, double from, long long at)
+    : Stage(std::move(stage))
+    , From(from)
+    , At(at)
+  {
+  }
+  std::atomic<long long> Polls{ 0 };
+
+protected:
+  bool pollCancel() override { return this->stageName() == Stage && this->overall() >= From && ++Polls >= At; }
+
+private:
+  std::string Stage;
+  double From;
+  long long At;
+};
+} // namespace
+
+TEST(CancelDistanceField, InsideOpenVDBsBandExpansion)
+{
+  // Without active points the stage covers [0.02, 0.315] of the run (a target > 0), OpenVDB's
+  // meshToVolume 0.6 of it, and its band expansion starts at 54 % of that: 0.1156. The first
+  // poll from there on is OpenVDB's own check before the expansion; later ones come from inside
+  // it (the mesh adapter, every 1024 distance computations per thread), which stops it by an
+  // exception that must not escape.
+  const PolygonMesh input = PolygonMesh::fromTriangles(largeSphere());
+  CageOptions options;
+  options.Envelope.UseActivePoints = false;
+  for (const long long at : { 3LL, 8LL })
+  {
+    CancelAfter progress("distance field and isosurface", 0.1156, at);
+    const CageResult r = generateCage(input, options, &progress);
+    EXPECT_EQ(r.State, Status::Cancelled) << "at poll " << at << ": " << statusName(r.State) << ": " << r.Message;
+    EXPECT_TRUE(r.Cage.empty());
+    EXPECT_TRUE(r.Envelope.empty());
+  }
+}
