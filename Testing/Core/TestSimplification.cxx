@@ -227,7 +227,10 @@ TEST(Simplification, CancelGivesAValidCoarserCage)
   protected:
     void report(double overall, const std::string& stage) override
     {
-      if (stage == "simplifying" && overall > 0.6)
+      // late in the simplification ([0.45, 0.95] of the run): a cage cut short is output only
+      // when it is verified within 0.15 s of the cancel (GracePeriod), which a cage cut at 0.6
+      // (some 14,000 vertices) missed on a loaded machine
+      if (stage == "simplifying" && overall > 0.9)
         this->cancel();
     }
   };
