@@ -1,5 +1,6 @@
 #include "Envelope/ActivePoints.h"
 
+#include "Common/CancellableSort.h"
 #include "Common/Progress.h"
 
 #include <tbb/blocked_range.h>
@@ -142,7 +143,9 @@ struct EdgeGraph
   std::vector<int> Neighbor;
   std::vector<double> Length;
 
-  explicit EdgeGraph(const TriangleMesh& mesh)
+  /// A cancel (`progress`) stops the construction: the graph is then incomplete, for the caller
+  /// to drop.
+  explicit EdgeGraph(const TriangleMesh& mesh, Progress* progress = nullptr)
   {
     const std::size_t n = mesh.Points.size();
     std::vector<std::pair<int, int>> edges;
@@ -158,7 +161,10 @@ struct EdgeGraph
         }
       }
     }
-    std::sort(edges.begin(), edges.end());
+    if (!cancellableSort(edges, progress))
+    {
+      edges.clear();
+    }
     edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
     Start.assign(n + 1, 0);
     for (const auto& e : edges)
@@ -310,13 +316,19 @@ std::vector<char> referencedPoints(const TriangleMesh& mesh)
 /// Sampling: greedy, in point order (deterministic): a referenced point not yet within
 /// `separation` of a sample *along the surface* becomes one. (A Euclidean cover would let one
 /// part's samples stand for a nearly touching other part, which then has no samples of its own.)
-std::vector<int> sampleSurface(const EdgeGraph& graph, const std::vector<char>& referenced, double separation)
+/// Stops (with some of the samples) once `progress` is cancelled.
+std::vector<int> sampleSurface(
+  const EdgeGraph& graph, const std::vector<char>& referenced, double separation, Progress* progress)
 {
   std::vector<int> samples;
   std::vector<char> covered(referenced.size(), 0);
   BoundedDijkstra cover(graph);
   for (std::size_t i = 0; i < referenced.size(); ++i)
   {
+    if (i % 8192 == 0 && progressCancelled(progress))
+    {
+      break;
+    }
     if (!referenced[i] || covered[i])
     {
       continue;
@@ -876,15 +888,16 @@ ActivePoints computeActivePoints(const TriangleMesh& unitInput, const ActivePoin
   const std::size_t n = S.Points.size();
   result.Active.assign(n, 0);
   result.GeodesicToActive.assign(n, result.Cutoff);
-  progressUpdate(progress, 0.05);
-  if (unitInput.empty() || !options.validate().empty())
+  const bool cancelled = progressUpdate(progress, 0.05);
+  if (unitInput.empty() || !options.validate().empty() || cancelled)
   {
+    result.Cancelled = cancelled;
     result.Seconds = seconds(t0);
     return result;
   }
 
   // sampling: samples half a spacing apart along the surface
-  const EdgeGraph graph(S);
+  const EdgeGraph graph(S, progress);
   if (progressCancelled(progress))
   {
     result.Cancelled = true;
@@ -893,7 +906,7 @@ ActivePoints computeActivePoints(const TriangleMesh& unitInput, const ActivePoin
   }
   const double separation = 0.5 * spacing;
   const std::vector<char> referenced = referencedPoints(S);
-  const std::vector<int> samples = sampleSurface(graph, referenced, separation);
+  const std::vector<int> samples = sampleSurface(graph, referenced, separation, progress);
   result.NumberOfSamples = samples.size();
   if (progressUpdate(progress, 0.1))
   {

@@ -453,12 +453,19 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
   auto inputTree = std::make_shared<TriangleTree>();
   tbb::task_group treeTask;
   const bool winding = result.SignUsed == SignMode::WindingNumber;
-  treeTask.run([&unitInput, inputTree, winding] {
-    inputTree->build(unitInput);
+  // A cancel cuts the build short (every return path waits for it); tree() then builds it
+  // again in full, should anything still ask for it.
+  std::atomic<bool> treeComplete{ false };
+  treeTask.run([&unitInput, inputTree, winding, progress, &treeComplete] {
+    if (!inputTree->build(unitInput, progress))
+    {
+      return;
+    }
     if (winding)
     {
       inputTree->prepareWindingNumbers();
     }
+    treeComplete.store(true);
   });
   struct WaitFor
   {
@@ -479,6 +486,14 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
     if (!treeReady)
     {
       treeTask.wait();
+      if (!treeComplete.load())
+      {
+        inputTree->build(unitInput);
+        if (winding)
+        {
+          inputTree->prepareWindingNumbers();
+        }
+      }
       treeReady = true;
     }
     return *inputTree;
@@ -486,7 +501,7 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
   {
     std::vector<int> comp;
     result.InputComponents = triangleComponents(unitInput, comp);
-    result.InputGenus = result.InputClosed ? genus(unitInput) : -1;
+    result.InputGenus = result.InputClosed ? closedManifoldGenus(unitInput, result.InputComponents) : -1;
   }
   if (progressCancelled(progress))
   {

@@ -30,16 +30,22 @@ namespace sdfcage
 namespace
 {
 
-/// OpenVDB interrupter backed by our Progress: one mechanism for both.
+/// OpenVDB interrupter backed by our Progress: one mechanism for both. Past `ExpansionPercent`
+/// (meshToVolume's narrow-band expansion, which checks only between its iterations, each seconds
+/// long on a large mesh) it arms `Expanding`: CancellableMeshAdapter stops the work from inside.
 class VdbInterrupter : public openvdb::util::NullInterrupter
 {
 public:
-  VdbInterrupter(Progress* p, double begin, double end)
+  VdbInterrupter(Progress* p, double begin, double end, std::atomic<bool>* expanding = nullptr)
     : P(p)
     , Begin(begin)
     , End(end)
+    , Expanding(expanding)
   {
   }
+  /// meshToVolume's progress (OpenVDB 10) when the band expansion starts.
+  static constexpr int ExpansionPercent = 54;
+
   bool wasInterrupted(int percent = -1) override
   {
     if (!P)
@@ -49,6 +55,10 @@ public:
     if (percent >= 0)
     {
       P->update(Begin + (End - Begin) * std::clamp(percent, 0, 100) / 100.0);
+      if (Expanding && percent >= ExpansionPercent)
+      {
+        Expanding->store(true);
+      }
     }
     return P->cancelled();
   }
@@ -56,6 +66,55 @@ public:
 private:
   Progress* P;
   double Begin, End;
+  std::atomic<bool>* Expanding;
+};
+
+/// Thrown by CancellableMeshAdapter: TBB carries it out of OpenVDB's parallel loops, and
+/// meshToVolume's caller catches it. (The expansion's nodes made so far are then not freed:
+/// OpenVDB holds them by raw pointers until the end of an iteration. A few megabytes per cancel.)
+struct VdbStopped
+{
+};
+
+/// The triangles for meshToVolume (as openvdb::tools::QuadAndTriangleDataAdapter gives them),
+/// with a cancel check in the one call every distance computation makes: once `expanding` is set
+/// (OpenVDB's own checks cover the voxelization before it), every 1024th call on a thread checks
+/// `progress` and throws VdbStopped when it is cancelled.
+class CancellableMeshAdapter
+{
+public:
+  CancellableMeshAdapter(const std::vector<openvdb::Vec3s>& points, const std::vector<openvdb::Vec3I>& triangles,
+    Progress* progress, const std::atomic<bool>* expanding)
+    : Points(points)
+    , Triangles(triangles)
+    , P(progress)
+    , Expanding(expanding)
+  {
+  }
+  std::size_t polygonCount() const { return Triangles.size(); }
+  std::size_t pointCount() const { return Points.size(); }
+  std::size_t vertexCount(std::size_t) const { return 3; }
+  void getIndexSpacePoint(std::size_t n, std::size_t v, openvdb::Vec3d& pos) const
+  {
+    if (P && Expanding->load(std::memory_order_relaxed))
+    {
+      thread_local unsigned calls = 0;
+      if ((++calls & 1023u) == 0 && P->cancelled())
+      {
+        throw VdbStopped();
+      }
+    }
+    const openvdb::Vec3s& p = Points[Triangles[n][static_cast<int>(v)]];
+    pos[0] = double(p[0]);
+    pos[1] = double(p[1]);
+    pos[2] = double(p[2]);
+  }
+
+private:
+  const std::vector<openvdb::Vec3s>& Points;
+  const std::vector<openvdb::Vec3I>& Triangles;
+  Progress* P;
+  const std::atomic<bool>* Expanding;
 };
 
 double seconds(std::chrono::steady_clock::time_point t0)
@@ -375,7 +434,8 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
     const Triangle& t = unitMesh.Triangles[order[f]];
     tris[f] = openvdb::Vec3I(t[0], t[1], t[2]);
   }
-  openvdb::tools::QuadAndTriangleDataAdapter<openvdb::Vec3s, openvdb::Vec3I> adapter(points, tris);
+  std::atomic<bool> expanding{ false };
+  const CancellableMeshAdapter adapter(points, tris, progress, &expanding);
   auto transform = openvdb::math::Transform::createLinearTransform(voxelSize);
 
   // The isosurface at `iso` needs values up to iso plus one voxel. Corners beyond the band read the
@@ -385,7 +445,7 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
   const float exteriorBand = static_cast<float>(std::ceil(iso / voxelSize) + 1.0);
   const bool unsignedField = sign != SignMode::FloodFill;
   const float interiorBand = unsignedField ? exteriorBand : 1.0f;
-  VdbInterrupter sdfInterrupter(progress, 0.0, 0.6);
+  VdbInterrupter sdfInterrupter(progress, 0.0, 0.6, &expanding);
   openvdb::FloatGrid::Ptr grid;
   openvdb::Int32Grid::Ptr closestTriangle;
   if (amplification)
@@ -396,6 +456,11 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
   {
     grid = openvdb::tools::meshToVolume<openvdb::FloatGrid>(sdfInterrupter, adapter, *transform, exteriorBand,
       interiorBand, unsignedField ? openvdb::tools::UNSIGNED_DISTANCE_FIELD : 0, closestTriangle.get());
+  }
+  catch (const VdbStopped&)
+  {
+    out.Cancelled = true;
+    return out;
   }
   catch (const std::exception& e)
   {

@@ -1,5 +1,6 @@
 #include "Mesh/Validation.h"
 
+#include "Common/CancellableSort.h"
 #include "Common/Progress.h"
 #include "Spatial/Geometry.h"
 
@@ -269,7 +270,8 @@ bool triangulateEars(const std::vector<Vec3>& pts, const std::int64_t* ids, std:
 // where at least one of the two is on a boundary edge (two points inside closed surfaces are never
 // merged), on hashed grids of cells of size tol; returns the number of merged points.
 std::int64_t mergeCoincidentPoints(const std::vector<Vec3>& pts, const std::vector<char>& referenced,
-  const std::vector<char>& onBoundary, const Vec3& origin, double tol, std::vector<std::int64_t>& representative)
+  const std::vector<char>& onBoundary, const Vec3& origin, double tol, std::vector<std::int64_t>& representative,
+  Progress* progress)
 {
   const std::size_t np = pts.size();
   representative.resize(np);
@@ -304,6 +306,10 @@ std::int64_t mergeCoincidentPoints(const std::vector<Vec3>& pts, const std::vect
   std::int64_t merged = 0;
   for (std::size_t i = 0; i < np; ++i)
   {
+    if ((i + 1) % (std::size_t(1) << 16) == 0 && progressCancelled(progress))
+    {
+      return merged; // the caller sees the cancel
+    }
     if (!referenced[i])
     {
       continue;
@@ -338,7 +344,11 @@ struct HalfEdge
 
 namespace
 {
-void checkTopology(const TriangleMesh& mesh, MeshDefects& d)
+/// Cells, triangles or vertices between two cancel checks of a loop over a whole mesh.
+constexpr std::size_t CheckEvery = std::size_t(1) << 16;
+
+/// Returns false when `progress` was cancelled (the counts are then incomplete).
+bool checkTopology(const TriangleMesh& mesh, MeshDefects& d, Progress* progress = nullptr)
 {
   const std::size_t nf = mesh.Triangles.size();
   std::vector<HalfEdge> he;
@@ -354,7 +364,8 @@ void checkTopology(const TriangleMesh& mesh, MeshDefects& d)
       he.push_back({ (static_cast<std::uint64_t>(lo) << 32) | hi, static_cast<int>(f), a < b });
     }
   }
-  std::sort(he.begin(), he.end(), [](const HalfEdge& x, const HalfEdge& y) { return x.Key < y.Key; });
+  if (!cancellableSort(he, [](const HalfEdge& x, const HalfEdge& y) { return x.Key < y.Key; }, progress))
+    return false;
   for (std::size_t i = 0; i < he.size();)
   {
     std::size_t j = i;
@@ -403,6 +414,8 @@ void checkTopology(const TriangleMesh& mesh, MeshDefects& d)
   std::vector<std::pair<int, int>> neighbourFace; // (other vertex, local triangle index)
   for (std::size_t v = 0; v < nv; ++v)
   {
+    if (v % CheckEvery == 0 && progressCancelled(progress))
+      return false;
     const int n = start[v + 1] - start[v];
     if (n == 0)
     {
@@ -448,8 +461,25 @@ void checkTopology(const TriangleMesh& mesh, MeshDefects& d)
       ++d.NonManifoldVertices;
     }
   }
+  return true;
 }
 } // namespace
+
+int closedManifoldGenus(const TriangleMesh& mesh, int components)
+{
+  std::vector<char> used(mesh.Points.size(), 0);
+  long long v = 0;
+  for (const Triangle& t : mesh.Triangles)
+    for (int i : t)
+      if (!used[i])
+      {
+        used[i] = 1;
+        ++v;
+      }
+  const long long f = static_cast<long long>(mesh.Triangles.size());
+  const long long chi = v - 3 * f / 2 + f;
+  return static_cast<int>((2LL * components - chi) / 2);
+}
 
 MeshDefects checkTriangleMesh(const TriangleMesh& mesh)
 {
@@ -565,9 +595,9 @@ MeshDefects prepareMesh(
           edges.push_back(std::min(u, v) << 32 | std::max(u, v));
       }
     }
+    cancellableSort(edges, progress); // false only when cancelled: cancelled() then clears the output
     if (cancelled())
       return d;
-    std::sort(edges.begin(), edges.end());
     std::vector<char> onBoundary(np, 0);
     bool any = false;
     // the corners of zero-area triangles count too: a sliver between two coincident points hides
@@ -602,7 +632,7 @@ MeshDefects prepareMesh(
     if (cancelled())
       return d;
     d.MergedPoints =
-      mergeCoincidentPoints(input.Points, referenced, onBoundary, lo, any ? d.MergeTolerance : -1.0, rep);
+      mergeCoincidentPoints(input.Points, referenced, onBoundary, lo, any ? d.MergeTolerance : -1.0, rep, progress);
   }
   if (cancelled())
     return d;
@@ -614,6 +644,8 @@ MeshDefects prepareMesh(
   std::vector<std::int64_t> ring;
   for (std::size_t c = 0; c < nc; ++c)
   {
+    if (c % CheckEvery == 0 && cancelled())
+      return d;
     if (!cellValid[c])
     {
       continue;
@@ -687,9 +719,9 @@ MeshDefects prepareMesh(
       std::sort(k.begin(), k.end());
       sorted[f] = { k, static_cast<int>(f) };
     }
+    cancellableSort(sorted, progress);
     if (cancelled())
       return d;
-    std::sort(sorted.begin(), sorted.end());
     std::vector<char> duplicate(kept.size(), 0);
     for (std::size_t i = 1; i < sorted.size(); ++i)
     {
@@ -722,7 +754,7 @@ MeshDefects prepareMesh(
   if (cancelled())
     return d;
   // 3. topology
-  checkTopology(output, d);
+  checkTopology(output, d, progress);
   if (cancelled())
     return d;
   std::vector<int> comp;
@@ -749,6 +781,8 @@ MeshDefects prepareMesh(
     {
       continue;
     }
+    if (cancelled())
+      return d;
     bool nested = false;
     if (d.Components > 1)
     {
@@ -797,7 +831,7 @@ MeshDefects prepareMesh(
   }
   if (cancelled())
     return d;
-  d.Genus = genus(output);
+  d.Genus = closedManifoldGenus(output, d.Components);
   return d;
 }
 

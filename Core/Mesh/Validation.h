@@ -79,10 +79,17 @@ struct ValidationOptions
 /// drops degenerate and duplicated triangles and unreferenced points, ignores vertex/line cells,
 /// measures closedness, manifoldness and orientation consistency, and flips a closed
 /// inward-oriented mesh. `output` is valid when the returned defects are usableAsInput().
-/// With `progress`, cancel checks between its steps: once cancelled it returns at the next one
-/// with `output` empty (the caller tells a cancel by progress->cancelled(), not by the defects).
+/// With `progress`, cancel checks between its steps and inside them (every 65,536 cells,
+/// triangles or vertices of a loop, every chunk of a sort: CancellableSort.h): once cancelled it
+/// returns at the next one with `output` empty (the caller tells a cancel by
+/// progress->cancelled(), not by the defects).
 MeshDefects prepareMesh(const PolygonMesh& input, TriangleMesh& output,
   const ValidationOptions& options = ValidationOptions(), Progress* progress = nullptr);
+
+/// Genus of a closed 2-manifold triangle mesh (MeshDefects::closedManifold()) of `components`
+/// connected parts: every edge has two triangles, so E = 3F/2 and no edge list is sorted (the
+/// same value as Mesh.h's genus(), which works on any mesh, in a fraction of its time).
+int closedManifoldGenus(const TriangleMesh& mesh, int components);
 
 /// The same checks on a triangle mesh, without conversion or flipping (used to check envelopes
 /// and cages). Orientation is reported through InconsistentEdges only.

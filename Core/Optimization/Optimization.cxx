@@ -1,5 +1,6 @@
 #include "Optimization/Optimization.h"
 
+#include "Common/GracePeriod.h"
 #include "Common/Progress.h"
 #include "Mesh/EdgeKey.h"
 #include "Mesh/Normalization.h"
@@ -334,6 +335,10 @@ public:
         tbb::blocked_range<std::size_t>(0, batch.size(), 1), [&](const tbb::blocked_range<std::size_t>& range) {
           for (std::size_t i = range.begin(); i != range.end(); ++i)
           {
+            // after a cancel, the rest of the batch stays where it is (every move made was
+            // checked: the cage is valid); the next update() ends the pass
+            if (progressCancelled(Prog))
+              break;
             const int v = batch[i];
             for (int step = 0; step < steps; ++step)
             {
@@ -1458,14 +1463,20 @@ private:
 /// One-sided Hausdorff distance cage -> input by branch and bound (the largest value reached;
 /// the bound is at most 1/32 of the largest triangle's size above it), and the fraction of
 /// triangle angles below `angle` degrees.
-double sampledHausdorff(const TriangleMesh& cage, const TriangleTree& tree)
+/// Once `progress` is cancelled it stops, with a lower bound of the distance.
+double sampledHausdorff(const TriangleMesh& cage, const TriangleTree& tree, Progress* progress = nullptr)
 {
   double lower = 0.0, upper = 0.0;
   for (const Triangle& t : cage.Triangles)
     for (int v : t)
       lower = std::max(lower, tree.distance(cage.Points[v]));
-  for (const Triangle& t : cage.Triangles)
+  for (std::size_t f = 0; f < cage.Triangles.size(); ++f)
+  {
+    if (f % 16 == 0 && progressCancelled(progress))
+      break;
+    const Triangle& t = cage.Triangles[f];
     triangleFarthest(tree, cage.Points[t[0]], cage.Points[t[1]], cage.Points[t[2]], FidelityDepth, lower, upper);
+  }
   return lower;
 }
 double smallAngleFraction(const TriangleMesh& cage, double angle)
@@ -1549,8 +1560,18 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
   std::string why;
   double measured = 0.0;
   const auto tv = std::chrono::steady_clock::now();
-  if (!verifyEnclosure(
-        input, cage, std::numeric_limits<double>::min(), measured, why, nullptr, nullptr, true, &inputTree))
+  const bool givenOk =
+    verifyEnclosure(input, cage, std::numeric_limits<double>::min(), measured, why, nullptr, progress, true, &inputTree);
+  if (progressCancelled(progress))
+  {
+    // the given cage is not known to be valid: no cage (the pipeline keeps its own, verified)
+    r.State = Status::Cancelled;
+    r.Message = "cancelled while the given cage was verified: no cage";
+    r.Cage = TriangleMesh();
+    r.Seconds = seconds(start);
+    return r;
+  }
+  if (!givenOk)
   {
     r.State = Status::InvalidInput;
     r.Message = "the given cage does not enclose the input without self-intersection: " + why;
@@ -1572,7 +1593,17 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
   r.MinimumAngleBefore = minimumAngle(cage);
   const bool mipsMode = options.Energy == CageEnergy::MIPS;
   r.SmallAnglesBefore = smallAngleFraction(cage, options.TargetMinimumAngle);
-  r.HausdorffBefore = sampledHausdorff(cage, inputTree);
+  r.HausdorffBefore = sampledHausdorff(cage, inputTree, progress);
+  if (progressCancelled(progress))
+  {
+    // the given cage, verified above (its distances are not measured again)
+    r.State = Status::Cancelled;
+    r.Reverted = true;
+    r.Message = "cancelled before the optimization: the given cage is returned unchanged";
+    r.MinimumClearance = measured;
+    r.Seconds = seconds(start);
+    return r;
+  }
   r.VerificationSeconds = seconds(tv);
 
   Optimizer opt(cage, input, inputTree, options, delta, selfDelta, progress);
@@ -1676,11 +1707,24 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
     result = std::move(best);
   double clearance = 0.0;
   std::vector<double> dist;
-  if (verifyEnclosure(input, result, delta, clearance, why, &dist, nullptr, true, &inputTree))
+  // after a cancel (before or during it) it gets VerificationGrace seconds
+  GracePeriod grace(progress, VerificationGrace);
+  if (verifyEnclosure(input, result, delta, clearance, why, &dist, progress ? &grace : nullptr, true, &inputTree))
   {
     r.Cage = std::move(result);
     r.MinimumClearance = clearance;
     r.DistanceToInput = std::move(dist);
+  }
+  else if (grace.expired())
+  {
+    // cancelled, and the optimized cage could not be verified in time: the given cage (verified
+    // above; its distances are not measured again)
+    cancelled = true;
+    r.Reverted = true;
+    r.Message = "cancelled during optimization; the optimized cage could not be verified in time: the given cage "
+                "is returned unchanged";
+    r.Cage = cage;
+    r.MinimumClearance = measured;
   }
   else
   {
@@ -1696,7 +1740,10 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
   r.EnergyAfter = cageEnergy(r.Cage, inputTree, options);
   r.MinimumAngleAfter = minimumAngle(r.Cage);
   r.SmallAnglesAfter = smallAngleFraction(r.Cage, options.TargetMinimumAngle);
-  r.HausdorffAfter = sampledHausdorff(r.Cage, inputTree);
+  // after a cancel, bounded by the verification's grace (then a lower bound)
+  r.HausdorffAfter = sampledHausdorff(r.Cage, inputTree, progress ? &grace : nullptr);
+  if (progress && grace.expired() && r.Message.find("lower bound") == std::string::npos)
+    r.Message += std::string(r.Message.empty() ? "" : "; ") + "HausdorffAfter is a lower bound (cut short by the cancel)";
   r.State = cancelled ? Status::Cancelled : Status::Ok;
   if (cancelled && r.Message.empty())
     r.Message = "cancelled during optimization; the cage so far is valid";

@@ -1,5 +1,6 @@
 #include "Pipeline/CageGenerator.h"
 
+#include "Common/GracePeriod.h"
 #include "Common/Progress.h"
 #include "Common/Threads.h"
 #include "Quality/Verification.h"
@@ -22,23 +23,6 @@ double seconds(std::chrono::steady_clock::time_point t0)
 {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
-
-/// Cancels itself `seconds` after its construction: the time budget of the verification of a cage
-/// cut short by a cancel (see below).
-class Deadline final : public Progress
-{
-public:
-  explicit Deadline(double seconds)
-    : End(std::chrono::steady_clock::now() + std::chrono::microseconds(static_cast<long long>(seconds * 1e6)))
-  {
-  }
-
-protected:
-  bool pollCancel() override { return std::chrono::steady_clock::now() >= this->End; }
-
-private:
-  std::chrono::steady_clock::time_point End;
-};
 } // namespace
 
 ScalarImage imageToInput(ScalarImage image, const Normalization& n)
@@ -193,22 +177,24 @@ CageResult generateOnce(const PolygonMesh& input, const CageOptions& options, Pr
     result.StopReason = result.Simplification.StopReason;
     // independent re-verification of the final cage (exact distances, winding numbers). It runs
     // even after a cancel: the partial cage is valid and usable. But a cancel must answer at
-    // once, and a cage cut short early is large: then (over 20,000 vertices: some 50 ms to verify
-    // on one core) the verification gets a short time budget, and no cage is output if it runs out.
+    // once, and a cage cut short early is large (15,000 vertices and more take a second or two
+    // on a loaded machine): after a cancel, during the simplification or this verification, it
+    // gets VerificationGrace seconds, and no cage is output if it runs out.
     progressStage(progress, "verifying cage", 0.95, options.Optimize ? 0.96 : 1.0);
     const auto t1 = std::chrono::steady_clock::now();
     std::vector<double> dist;
     std::string why;
     double clearance = 0.0;
-    Deadline budget(0.2);
+    GracePeriod grace(progress, VerificationGrace);
     const bool ok = verifyEnclosure(unit, result.Simplification.Cage, so.Clearance, clearance, why, &dist,
-      result.Simplification.Cancelled && result.Simplification.Cage.Points.size() > 20000 ? &budget : nullptr, true,
-      &tree);
+      progress ? &grace : nullptr, true, &tree);
     result.CageVerificationSeconds = seconds(t1);
-    if (!ok && result.Simplification.Cancelled && budget.cancelled())
+    if (!ok && grace.expired())
     {
       result.State = Status::Cancelled;
-      result.Message = "cancelled during simplification; the cage so far was too large to verify at once: no cage";
+      result.Message = result.Simplification.Cancelled
+        ? "cancelled during simplification; the cage so far could not be verified in time: no cage"
+        : "cancelled while the cage was verified: no cage";
       result.TotalSeconds = seconds(start);
       return result;
     }
@@ -229,7 +215,9 @@ CageResult generateOnce(const PolygonMesh& input, const CageOptions& options, Pr
       result.Optimization = optimizeCage(result.Simplification.Cage, unit, tree, oo, progress, 0.96, 1.0);
       result.OptimizationSeconds = result.Optimization.Seconds;
       const Status os = result.Optimization.State;
-      if ((os == Status::Ok || os == Status::Cancelled) && !result.Optimization.Reverted)
+      // (a cancel while the optimization verified the given cage leaves it no cage: ours stays)
+      if ((os == Status::Ok || os == Status::Cancelled) && !result.Optimization.Reverted &&
+        !result.Optimization.Cage.Triangles.empty())
       {
         result.Optimized = true;
         result.Simplification.Cage = std::move(result.Optimization.Cage);

@@ -194,9 +194,16 @@ public:
       PlacementReach = std::max(16.0 * Opt.Clearance, edge);
     }
     for (std::size_t v = 0; v < P.size(); ++v)
+    {
+      if (v % 4096 == 0 && progressCancelled(Prog))
+      {
+        r.Cancelled = true; // drain() stops at once
+        break;
+      }
       for (int n : neighbours(static_cast<int>(v)))
         if (static_cast<int>(v) < n)
           pushEdge(static_cast<int>(v), n);
+    }
     // Pass 0 is the ordinary run. When the queue runs dry above the target, later passes retry
     // every blocked edge with a more thorough placement search (pass 1) and then with relaxed
     // shape bounds (pass 2, see relaxShape()); a pass that collapses something is repeated.
@@ -250,6 +257,8 @@ public:
     const double margin = Opt.selfClearance();
     while (AliveVertices > target && !Heap.empty())
     {
+      // progress every 16 batches; a cancel check every batch (a batch is some 10 ms, 16 of them
+      // made a cancel wait up to 0.3 s on a loaded machine)
       if (++BatchesSinceProgress >= 16)
       {
         BatchesSinceProgress = 0;
@@ -258,6 +267,11 @@ public:
           r.Cancelled = true;
           break;
         }
+      }
+      else if (progressCancelled(Prog))
+      {
+        r.Cancelled = true;
+        break;
       }
       // form: valid entries in queue order, skipping (for the next batch) those next to a member
       int n = 0;

@@ -1,5 +1,6 @@
 #include "Spatial/TriangleTree.h"
 
+#include "Common/Progress.h"
 #include "Spatial/Geometry.h"
 
 #include <algorithm>
@@ -30,18 +31,26 @@ int subtreeNodes(int count, int depth)
 
 void TriangleTree::build(const TriangleMesh& mesh)
 {
+  this->build(mesh, nullptr);
+}
+
+bool TriangleTree::build(const TriangleMesh& mesh, Progress* progress)
+{
   Nodes.clear();
+  Dipoles.clear();
   Tri.clear();
   Normals.clear();
   const std::size_t n = mesh.Triangles.size();
   if (n == 0)
   {
-    return;
+    return !progressCancelled(progress);
   }
   std::vector<Tri3> tri(n);
   Normals.resize(n);
   std::vector<Vec3> centroids(n);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+    if (progressCancelled(progress))
+      return;
     for (std::size_t f = r.begin(); f != r.end(); ++f)
     {
       const Triangle& t = mesh.Triangles[f];
@@ -63,17 +72,31 @@ void TriangleTree::build(const TriangleMesh& mesh)
   {
     items[f] = { centroids[f], static_cast<int>(f) };
   }
-  buildNode(0, 0, static_cast<int>(n), items, tri, 0);
+  if (!progressCancelled(progress))
+  {
+    buildNode(0, 0, static_cast<int>(n), items, tri, 0, progress);
+  }
+  if (progressCancelled(progress))
+  {
+    Nodes.clear(); // some subtrees were skipped: nothing of it may be used
+    Normals.clear();
+    return false;
+  }
   Tri.resize(n);
   for (std::size_t i = 0; i < n; ++i)
   {
     Tri[i] = tri[items[i].Id];
   }
+  return true;
 }
 
-void TriangleTree::buildNode(
-  int index, int start, int count, std::vector<BuildItem>& items, const std::vector<Tri3>& tri, int depth)
+void TriangleTree::buildNode(int index, int start, int count, std::vector<BuildItem>& items,
+  const std::vector<Tri3>& tri, int depth, Progress* progress)
 {
+  if (count > 8192 && progressCancelled(progress))
+  {
+    return; // build() clears the tree
+  }
   Node& node = Nodes[index];
   if (count <= 4 || depth > 60)
   {
@@ -111,8 +134,8 @@ void TriangleTree::buildNode(
   const int right = left + subtreeNodes(half, depth + 1);
   node.Left = left;
   node.Right = right;
-  auto buildLeft = [&] { buildNode(left, start, half, items, tri, depth + 1); };
-  auto buildRight = [&] { buildNode(right, start + half, count - half, items, tri, depth + 1); };
+  auto buildLeft = [&] { buildNode(left, start, half, items, tri, depth + 1, progress); };
+  auto buildRight = [&] { buildNode(right, start + half, count - half, items, tri, depth + 1, progress); };
   if (count > 8192)
   {
     tbb::parallel_invoke(buildLeft, buildRight);

@@ -10,12 +10,17 @@
 namespace sdfcage
 {
 
+class Progress;
+
 class TriangleTree
 {
 public:
   TriangleTree() = default;
   explicit TriangleTree(const TriangleMesh& mesh) { this->build(mesh); }
   void build(const TriangleMesh& mesh);
+  /// The same with cancel checks (about every 8,000 triangles): false, and an empty tree, once
+  /// `progress` is cancelled.
+  bool build(const TriangleMesh& mesh, Progress* progress);
 
   /// Closest point on the mesh to p within maxDistance (<0: unlimited). False when none.
   bool closestPoint(const Vec3& p, double maxDistance, Vec3& closest, int& triangle, double& distance) const;
@@ -68,8 +73,8 @@ private:
     Vec3 C; // centroid
     int Id;
   };
-  void buildNode(
-    int index, int start, int count, std::vector<BuildItem>& items, const std::vector<Tri3>& tri, int depth);
+  void buildNode(int index, int start, int count, std::vector<BuildItem>& items, const std::vector<Tri3>& tri,
+    int depth, Progress* progress);
   double triangleQuery(const Vec3 t[3], double limit, bool stopAtFirst, std::vector<int>* within = nullptr) const;
   struct Dipole
   {

@@ -48,6 +48,11 @@ def main():
         p = subprocess.Popen([a.cli, "--quiet", a.mesh, "-o", out], stdout=subprocess.DEVNULL,
                              stderr=subprocess.PIPE)
         time.sleep(at)
+        if p.poll() is not None:
+            # the run was faster than the uninterrupted one (the machine's load changed): no try
+            p.communicate()
+            print(f"SIGINT at {at:6.2f} s ({stage:>16}): the run ended first (exit {p.returncode})")
+            continue
         sent = time.monotonic()
         p.send_signal(signal.SIGINT)
         p.communicate()

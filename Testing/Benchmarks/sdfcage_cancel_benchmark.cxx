@@ -6,8 +6,9 @@
 // SetAbortExecute(1). So the latency includes the time until the filter next fires a progress
 // event, and then until Core's next cancel check answers. One uninterrupted run first gives the
 // stages (the filter's progress texts) and how long each lasts; then, for each stage and each k of
-// K, a run requests the abort (k + 0.5)/K of that stage's duration after the stage starts (so the
-// tries follow the stages even when the machine's load changes the timings). The stage of a try
+// K, a run requests the abort (k + 0.5)/K of that stage's duration after the stage first starts
+// (so the tries follow the stages even when the machine's load changes the timings; a stage that
+// comes back, like the optimization's sweeps, is tried at its first occurrence). The stage of a try
 // is the progress text at the moment of the request.
 //
 // After each cancelled run the cage output must be empty or a cage that the exact checker
@@ -15,8 +16,9 @@
 // a broken one makes the program exit with 1. A benchmark (prints figures), not a timed test.
 //
 //   sdfcage_cancel_benchmark [MESH] [--per-stage K] [--threads T] [--vertices V] [--iso C]
-//                            [--optimize] [--builtin] [--no-check]
-//   (default MESH: SDFCAGE_DATA_DIR/armadillo_midsub4x.obj, K = 3)
+//                            [--optimize] [--builtin] [--no-check] [--only TEXT]...
+//   (default MESH: SDFCAGE_DATA_DIR/armadillo_midsub4x.obj, K = 3; --only: tries in the stages
+//   whose progress text contains TEXT only, e.g. --only validating --only "active points")
 #include "vtkSDFCageFilter.h"
 
 #include "MeshIO.h"
@@ -103,6 +105,7 @@ struct Options
   double IsoValue = -1.0;
   bool Optimize = false;
   bool Check = true;
+  std::vector<std::string> Only; ///< tries only in the stages whose text contains one of these
 };
 
 /// What one run saw: the progress texts with their times, and (for a cancelled run) the time of
@@ -223,10 +226,12 @@ int main(int argc, char* argv[])
       o.Builtin = true;
     else if (a == "--no-check")
       o.Check = false;
+    else if (a == "--only")
+      o.Only.push_back(next());
     else if (a == "-h" || a == "--help")
     {
       std::printf("usage: sdfcage_cancel_benchmark [MESH] [--per-stage K] [--threads T] [--vertices V] [--iso C] "
-                  "[--optimize] [--builtin] [--no-check]\n");
+                  "[--optimize] [--builtin] [--no-check] [--only TEXT]...\n");
       return 0;
     }
     else if (!a.empty() && a[0] == '-')
@@ -272,11 +277,18 @@ int main(int argc, char* argv[])
     for (const auto& e : record.Texts)
       std::printf(" %.2f %s;", e.first, e.second.c_str());
     std::printf("\n");
+    // each stage once, at its first occurrence: a try waits for the stage's first showing (the
+    // optimization's stages come back every sweep; trying them again would repeat the same tries)
     for (std::size_t k = 0; k < record.Texts.size(); ++k)
     {
       const double end = k + 1 < record.Texts.size() ? record.Texts[k + 1].first : total;
-      if (!record.Texts[k].second.empty())
-        stages.emplace_back(record.Texts[k].second, end - record.Texts[k].first);
+      const std::string& text = record.Texts[k].second;
+      const bool seen = std::any_of(
+        stages.begin(), stages.end(), [&text](const std::pair<std::string, double>& s) { return s.first == text; });
+      const bool wanted = o.Only.empty() ||
+        std::any_of(o.Only.begin(), o.Only.end(), [&text](const std::string& w) { return text.find(w) != std::string::npos; });
+      if (!text.empty() && !seen && wanted)
+        stages.emplace_back(text, end - record.Texts[k].first);
     }
     std::printf("longest time between progress events (the filter's Abort is polled there), per stage:\n");
     for (const auto& g : record.StageGaps)
