@@ -26,7 +26,8 @@ slow_core=(AnyMeshRepairs.ForcedRulesAreHonoured AnyMeshWidening.OffKeepsTheIsov
   Simplification.ExactVertexCountsAndGuarantees ShapeAwareEnvelope.PlatesStaySeparateAndEnclosed
   Simplification.DeterministicAcrossThreadCounts ActivePointAnalysis.InputCoordinatesAndFields
   Simplification.CoarseTargetsAreReached GenerateCage.OtherVertexCounts Cancel.FromReportLateInTheRunGivesCancelled
-  CageErrors.OpenInputIsCagedAndReported Simplification.PlainQEMFailsWhereConstrainedPasses)
+  CageErrors.OpenInputIsCagedAndReported Simplification.PlainQEMFailsWhereConstrainedPasses
+  CancelSimplification.OutputsNothingOrAVerifiedCage)
 status=0
 run() {
   local name="$1"
