@@ -116,6 +116,10 @@ void printUsage(std::ostream& os)
         "                          automatic clearance), default 2; 0 = off\n"
         "      --require-topology  exit 1 and write no cage if the cage's genus or number of parts\n"
         "                          still differs from the closed input's (default: a warning)\n"
+        "      --no-coarse-first   with the automatic voxel size, do not try the grid twice as\n"
+        "                          coarse first (by default a closed input without active points\n"
+        "                          is tried on it and kept only if verified with the input's genus\n"
+        "                          and parts; otherwise the C/2 grid follows)\n"
         "      --memory-limit MB   memory budget of the envelope (distance grid, isosurface,\n"
         "                          verification), estimated before each grid is built: over it the\n"
         "                          run stops with the need named (exit 3); default 0 = automatic\n"
@@ -172,6 +176,7 @@ struct Options
   int Widenings = -1;       ///< -1 = the filter's default
   int TopologyRepairs = -1; ///< -1 = the filter's default
   bool RequireTopology = false;
+  bool NoCoarseFirst = false;
   double MemoryLimit = 0.0; ///< MiB, 0 = automatic (3/4 of the physical memory)
   bool NoActivePoints = false;
   double ActiveRadius = -1.0;      ///< -1 = the filter's default
@@ -411,6 +416,8 @@ bool parseBuildOption(ArgumentCursor& a, Options& o, vtkSDFCageFilter* limits)
       a.integer(limits->GetMaximumTopologyRepairsMinValue(), limits->GetMaximumTopologyRepairsMaxValue());
   else if (arg == "--require-topology")
     o.RequireTopology = true;
+  else if (arg == "--no-coarse-first")
+    o.NoCoarseFirst = true;
   else if (arg == "--no-active-points")
     o.NoActivePoints = true;
   else if (arg == "--active-radius")
@@ -798,6 +805,8 @@ void configureFilter(vtkSDFCageFilter* filter, const Options& o, RunReport& r)
   if (o.TopologyRepairs >= 0)
     filter->SetMaximumTopologyRepairs(o.TopologyRepairs);
   filter->SetRequireTopology(o.RequireTopology ? 1 : 0);
+  if (o.NoCoarseFirst)
+    filter->SetCoarseFirst(0);
   filter->SetMemoryLimit(o.MemoryLimit);
   filter->SetUseActivePoints(o.NoActivePoints ? 0 : 1);
   if (o.ActiveRadius >= 0)
@@ -821,6 +830,7 @@ void configureFilter(vtkSDFCageFilter* filter, const Options& o, RunReport& r)
   filter->SetSignMode(o.Sign == "flood" ? 1 : o.Sign == "winding" ? 2 : o.Sign == "unsigned" ? 3 : 0);
 
   r.UseActivePoints = filter->GetUseActivePoints() != 0;
+  r.CoarseFirst = filter->GetCoarseFirst() != 0;
   r.ActiveRadius = filter->GetActiveRadius();
   r.GeodesicThreshold = filter->GetGeodesicThreshold();
   r.AmplificationAlpha = filter->GetAmplificationAlpha();
