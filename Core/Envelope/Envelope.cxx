@@ -1046,34 +1046,13 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
   EnvelopeResult best = std::move(first);
   int rounds = 0;
   const int maxRounds = std::min(options.MaximumTopologyRepairs, 2);
-  // Round 1 is first tried on the requested grid: the gap rule and the stronger amplification
-  // often separate the parts there already (dragon_quartet), and a grid as fine as h/2 everywhere
-  // gives 4x the envelope triangles (545k on dragon_quartet) that the simplification then pays
-  // for. Only if the topology still differs does round 1 go on at h/2.
-  struct Step
-  {
-    int Round;
-    double Scale;
-  };
-  std::vector<Step> steps;
   for (int round = 1; round <= maxRounds; ++round)
   {
-    if (round == 1)
-    {
-      steps.push_back({ 1, 1.0 });
-    }
-    steps.push_back({ round, round == 1 ? 0.5 : 0.25 });
-  }
-  int lastRound = 0;
-  for (const Step& step : steps)
-  {
-    const int round = step.Round;
     EnvelopeOptions o = options;
     o.MaximumTopologyRepairs = 0;
     o.RequireTopology = false;
-    o.CoarseFirst = false;
     o.ActivePoints.GapRatio = options.ActivePoints.GapRatio > 0 ? options.ActivePoints.GapRatio : 3.0;
-    o.VoxelSize = step.Scale * h0;
+    o.VoxelSize = round == 1 ? 0.5 * h0 : 0.25 * h0;
     const double delta = round == 2 && automaticClearance ? 0.4 * delta0 : delta0;
     o.MinimumClearance = delta;
     // the envelope at an active point lies at about c / alpha: keep it 15% beyond the clearance
@@ -1090,8 +1069,7 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
     const std::string stage = "repairing topology (round " + std::to_string(round) + ")";
     progressStage(progress, stage.c_str(), 0.02, progressEnd);
     EnvelopeResult r = buildEnvelopeOnce(unitInput, o, progress, progressEnd, inputClosed ? 1 : 0);
-    rounds += round != lastRound ? 1 : 0;
-    lastRound = round;
+    ++rounds;
     if (r.State == Status::Cancelled || progressCancelled(progress))
     {
       r.State = Status::Cancelled;
