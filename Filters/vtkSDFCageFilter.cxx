@@ -66,6 +66,7 @@ vtkSDFCageFilter::vtkSDFCageFilter()
   this->MaximumEnvelopeWidenings = cageDefaults.MaximumEnvelopeWidenings;
   this->MaximumTopologyRepairs = defaults.MaximumTopologyRepairs;
   this->RequireTopology = defaults.RequireTopology ? 1 : 0;
+  this->CoarseFirst = defaults.CoarseFirst ? 1 : 0;
   this->GenerateDistanceField = defaults.KeepDistanceField ? 1 : 0;
   this->UseActivePoints = defaults.UseActivePoints ? 1 : 0;
   this->ActiveRadius = defaults.ActivePoints.Radius;
@@ -183,6 +184,7 @@ sdfcage::CageOptions CageOptionsOf(vtkSDFCageFilter* f)
   options.MaximumEnvelopeWidenings = f->GetMaximumEnvelopeWidenings();
   options.Envelope.MaximumTopologyRepairs = f->GetMaximumTopologyRepairs();
   options.Envelope.RequireTopology = f->GetRequireTopology() != 0;
+  options.Envelope.CoarseFirst = f->GetCoarseFirst() != 0;
   options.Envelope.MemoryLimit = static_cast<std::size_t>(f->GetMemoryLimit() * 1048576.0);
   options.Envelope.KeepDistanceField = f->GetGenerateDistanceField() != 0;
   options.Envelope.UseActivePoints = f->GetUseActivePoints() != 0;
@@ -577,6 +579,7 @@ void vtkSDFCageFilter::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "MaximumEnvelopeWidenings: " << this->MaximumEnvelopeWidenings << "\n";
   os << indent << "MaximumTopologyRepairs: " << this->MaximumTopologyRepairs << "\n";
   os << indent << "RequireTopology: " << this->RequireTopology << "\n";
+  os << indent << "CoarseFirst: " << this->CoarseFirst << "\n";
   os << indent << "MemoryLimit: " << this->MemoryLimit << " MiB (0 = automatic)\n";
   os << indent << "UseActivePoints: " << (this->UseActivePoints ? "On" : "Off") << "\n";
   os << indent << "ActiveRadius: " << this->ActiveRadius << "\n";

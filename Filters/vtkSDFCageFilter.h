@@ -270,6 +270,18 @@ public:
 
   ///@{
   /**
+   * Coarse grid first: with the automatic voxel size, a closed input without active points is
+   * first sampled on a grid twice as coarse (voxel = IsoValue); its envelope is kept only when it
+   * is verified and has the input's genus and parts, otherwise the automatic grid (IsoValue / 2)
+   * follows. VoxelSizeUsed in the field data says which grid was kept. Default off (Core's).
+   */
+  vtkSetMacro(CoarseFirst, vtkTypeBool);
+  vtkGetMacro(CoarseFirst, vtkTypeBool);
+  vtkBooleanMacro(CoarseFirst, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
    * Memory budget of the envelope in MiB (its distance grid, isosurface and verification, as
    * estimated before each grid is built): a grid whose need exceeds it is not built; the run
    * stops with an error naming the need (status Failed), and a finer refinement grid over it is
@@ -458,6 +470,7 @@ protected:
   int MaximumEnvelopeWidenings;
   int MaximumTopologyRepairs;
   vtkTypeBool RequireTopology;
+  vtkTypeBool CoarseFirst;
   double MemoryLimit = 0.0;
   vtkTypeBool GenerateDistanceField;
   int NumberOfThreads;

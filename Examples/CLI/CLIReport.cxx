@@ -140,6 +140,7 @@ std::string toJson(const RunReport& r)
   key("TargetNumberOfVertices") << r.TargetNumberOfVertices;
   key("Adaptivity") << jsonNumber(r.Adaptivity);
   key("MaximumRefinements") << r.MaximumRefinements;
+  key("CoarseFirst") << (r.CoarseFirst ? "true" : "false");
   key("Optimize") << jsonString(r.Optimize);
   key("TargetSpacing") << jsonNumber(r.TargetSpacing);
   key("NumberOfIterations") << r.NumberOfIterations;

@@ -60,6 +60,7 @@ struct RunReport
   int MaximumSweeps = 0;
   int NumberOfThreads = 0;
   bool UseActivePoints = true;
+  bool CoarseFirst = true;
   double ActiveRadius = 0.0;
   double GeodesicThreshold = 0.0;
   double AmplificationAlpha = 0.0;

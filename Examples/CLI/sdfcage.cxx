@@ -117,6 +117,10 @@ void printUsage(std::ostream& os)
         "                          automatic clearance), default 2; 0 = off\n"
         "      --require-topology  exit 1 and write no cage if the cage's genus or number of parts\n"
         "                          still differs from the closed input's (default: a warning)\n"
+        "      --coarse-first      with the automatic voxel size, try the grid twice as coarse\n"
+        "                          first: a closed input without active points is tried on it and\n"
+        "                          kept only if verified with the input's genus and parts, else\n"
+        "                          the C/2 grid follows (default off; --no-coarse-first: off)\n"
         "      --memory-limit MB   memory budget of the envelope (distance grid, isosurface,\n"
         "                          verification), estimated before each grid is built: over it the\n"
         "                          run stops with the need named (exit 3); default 0 = automatic\n"
@@ -183,6 +187,7 @@ struct Options
   int Widenings = -1;       ///< -1 = the filter's default
   int TopologyRepairs = -1; ///< -1 = the filter's default
   bool RequireTopology = false;
+  int CoarseFirst = -1; ///< -1 = the filter's default
   double MemoryLimit = 0.0; ///< MiB, 0 = automatic (3/4 of the physical memory)
   bool NoActivePoints = false;
   double ActiveRadius = -1.0;      ///< -1 = the filter's default
@@ -425,6 +430,10 @@ bool parseBuildOption(ArgumentCursor& a, Options& o, vtkSDFCageFilter* limits)
       a.integer(limits->GetMaximumTopologyRepairsMinValue(), limits->GetMaximumTopologyRepairsMaxValue());
   else if (arg == "--require-topology")
     o.RequireTopology = true;
+  else if (arg == "--coarse-first")
+    o.CoarseFirst = 1;
+  else if (arg == "--no-coarse-first")
+    o.CoarseFirst = 0;
   else if (arg == "--no-active-points")
     o.NoActivePoints = true;
   else if (arg == "--active-radius")
@@ -824,6 +833,8 @@ void configureFilter(vtkSDFCageFilter* filter, const Options& o, RunReport& r)
   if (o.TopologyRepairs >= 0)
     filter->SetMaximumTopologyRepairs(o.TopologyRepairs);
   filter->SetRequireTopology(o.RequireTopology ? 1 : 0);
+  if (o.CoarseFirst >= 0)
+    filter->SetCoarseFirst(o.CoarseFirst);
   filter->SetMemoryLimit(o.MemoryLimit);
   filter->SetUseActivePoints(o.NoActivePoints ? 0 : 1);
   if (o.ActiveRadius >= 0)
@@ -853,6 +864,7 @@ void configureFilter(vtkSDFCageFilter* filter, const Options& o, RunReport& r)
   filter->SetSignMode(o.Sign == "flood" ? 1 : o.Sign == "winding" ? 2 : o.Sign == "unsigned" ? 3 : 0);
 
   r.UseActivePoints = filter->GetUseActivePoints() != 0;
+  r.CoarseFirst = filter->GetCoarseFirst() != 0;
   r.ActiveRadius = filter->GetActiveRadius();
   r.GeodesicThreshold = filter->GetGeodesicThreshold();
   r.AmplificationAlpha = filter->GetAmplificationAlpha();

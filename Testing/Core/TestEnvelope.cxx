@@ -301,6 +301,59 @@ TEST(CoarseFirst, KeepsWhatTheRequestedGridKeeps)
   EXPECT_GE(fellBack, 1) << "no torus exercised the fallback from the coarse grid";
 }
 
+// A closed tube along a circle that runs on past its start and through its own first part (the
+// cow's tail pushed into its body): the surface has genus 0, the solid the flood fill sees is a
+// ring (genus 1). No envelope can separate what the input itself joins, so no topology repair
+// round runs (each would sample a finer grid everywhere: the 5k-face cow spent 100 s in them),
+// the envelope keeps the solid's genus, and the warning names where the input crosses itself.
+TEST(TopologyRepair, SelfCrossingInputRunsNoRound)
+{
+  std::vector<Vec3> line;
+  const int n = 240;
+  const double turn = 2.0 * M_PI + 0.6;
+  for (int i = 0; i <= n; ++i)
+  {
+    const double a = turn * i / n;
+    const double radius = 0.6 + 0.05 * a / (2.0 * M_PI); // the end passes beside the start, inside its tube
+    line.push_back(Vec3(radius * std::cos(a), radius * std::sin(a), 0.0));
+  }
+  const TriangleMesh tube = makeTube(line, 0.1, 24, Vec3(0, 0, 1));
+  const Normalization norm = Normalization::fit(tube);
+  const TriangleMesh unit = norm.toUnit(tube);
+  EnvelopeOptions options;
+  const EnvelopeResult r = buildEnvelope(unit, options);
+  ASSERT_EQ(r.State, Status::Ok) << r.Message;
+  EXPECT_TRUE(r.InputClosed);
+  EXPECT_EQ(r.InputGenus, 0);
+  EXPECT_EQ(r.Genus, 1) << "the envelope of a ring";
+  EXPECT_EQ(r.TopologyRepairs, 0) << r.TopologyRepairLog;
+  ASSERT_FALSE(r.SelfFusedSites.empty());
+  for (const Vec3& p : r.SelfFusedSites)
+  {
+    // where the end overlaps the start: near angle 0
+    const Vec3 q = norm.toInput(p);
+    EXPECT_LT(std::abs(std::atan2(q.y(), q.x())), 0.8) << p.transpose();
+  }
+  EXPECT_NE(r.TopologyWarning.find("intersects itself"), std::string::npos) << r.TopologyWarning;
+  EXPECT_NE(r.TopologyRepairLog.find("no repair round"), std::string::npos) << r.TopologyRepairLog;
+  EXPECT_TRUE(r.EnclosureVerified);
+  // strict: no envelope, whatever the reason
+  options.RequireTopology = true;
+  const EnvelopeResult strict = buildEnvelope(unit, options);
+  EXPECT_EQ(strict.State, Status::TopologyChanged);
+  EXPECT_TRUE(strict.Envelope.empty());
+  // an input crossing nothing still gets its repair rounds (the gap shapes of TestTopology keep
+  // their genus through them): the ring cut short of its start is a plain tube, genus 0
+  std::vector<Vec3> open(line.begin(), line.begin() + n * 5 / 6);
+  const TriangleMesh cut = makeTube(open, 0.1, 24, Vec3(0, 0, 1));
+  const TriangleMesh cutUnit = Normalization::fit(cut).toUnit(cut);
+  options.RequireTopology = false;
+  const EnvelopeResult plain = buildEnvelope(cutUnit, options);
+  ASSERT_EQ(plain.State, Status::Ok) << plain.Message;
+  EXPECT_EQ(plain.Genus, 0);
+  EXPECT_TRUE(plain.SelfFusedSites.empty());
+}
+
 TEST(Envelope, LargerIsoValueExplicitAndExactClearance)
 {
   const TriangleMesh input = makeTorus(Vec3(0, 0, 0), 1.0, 0.35, 64, 24);

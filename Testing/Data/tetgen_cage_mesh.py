@@ -121,6 +121,31 @@ def tet_volume(node_path, ele_path):
     return total
 
 
+def flat_wedges(points, triangles, min_dihedral=179.9):
+    """Edges of a closed mesh whose two triangles are within 180 - min_dihedral degrees of
+    coplanar, and the sum over them of the volume of the tetrahedron their four corners span.
+    TetGen 1.5's -p merges adjacent facets that flat (its default facet angle tolerance, 0.1
+    degree) and triangulates the merged facet with its own diagonals: the meshed domain then
+    differs from the PLC by such wedges (-M keeps every facet as given)."""
+    a, b, c = (points[triangles[:, k]] for k in range(3))
+    n = np.cross(b - a, c - a)
+    n /= np.linalg.norm(n, axis=1)[:, None]
+    edges = {}
+    for i, t in enumerate(triangles):
+        for k in range(3):
+            edges.setdefault(tuple(sorted((t[k], t[(k + 1) % 3]))), []).append((i, t[(k + 2) % 3]))
+    count, volume = 0, 0.0
+    for (u, v), faces in edges.items():
+        if len(faces) != 2:
+            continue
+        cosine = np.clip(np.dot(n[faces[0][0]], n[faces[1][0]]), -1.0, 1.0)
+        if 180.0 - np.degrees(np.arccos(cosine)) > min_dihedral:
+            p = [points[u], points[v], points[faces[0][1]], points[faces[1][1]]]
+            volume += abs(np.dot(p[1] - p[0], np.cross(p[2] - p[0], p[3] - p[0]))) / 6.0
+            count += 1
+    return count, volume
+
+
 def write_smesh(path, cage, mesh, holes):
     cp, ct = cage
     mp, mt = mesh
@@ -172,32 +197,41 @@ def main():
         cage = read_off(cage_file)
         smesh = stem + ".smesh"
         write_smesh(smesh, cage, mesh, holes)
-        for old in (stem + ".1.ele", stem + ".1.node", stem + ".1.face"):
-            if os.path.exists(old):
-                os.remove(old)
-        start = time.time()
-        r = subprocess.run([tetgen, "-pQ", smesh], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
-        seconds = time.time() - start
-        ele = stem + ".1.ele"
-        tets = 0
-        if os.path.exists(ele):
-            with open(ele) as f:
-                tets = int(f.readline().split()[0])
-        ok = r.returncode == 0 and tets > 0
-        volume_note = ""
-        if ok:
-            # the tetrahedra fill exactly the space between the cage and the input
-            meshed = tet_volume(stem + ".1.node", ele)
-            between = signed_volume(*cage) - abs(signed_volume(*mesh))
-            volume_ok = abs(meshed - between) <= 1e-6 * abs(signed_volume(*cage))
-            volume_note = ", volume %.6g (cage - input %.6g)" % (meshed, between)
-            if len(holes) > 0 and not volume_ok:
-                ok = False
-        print("%s: %s cage %d vertices: tetgen -pQ exit %d, %d tetrahedra, %.1f s%s" %
-              ("ok  " if ok else "FAIL", optimize, len(cage[0]), r.returncode, tets, seconds, volume_note))
-        if not ok:
-            print(r.stdout[-2000:])
-            failures += 1
+        between = signed_volume(*cage) - abs(signed_volume(*mesh))
+        tolerance = 1e-6 * abs(signed_volume(*cage))
+        flat_edges, wedges = flat_wedges(*cage)
+        # `tetgen -pQ` as a user types it, then `tetgen -pQM` (no merge of nearly coplanar facets):
+        # the latter meshes exactly the PLC, so its tetrahedra must fill the space between cage
+        # and input to 1e-6; the former may differ by the wedges of the cage edges it merges
+        # across (a flat cage region, e.g. fertility's base: 8 edges within 0.1 degree of flat,
+        # 4.1 of 59198 volume units), and by no more.
+        for switches, extra in (("-pQ", wedges), ("-pQM", 0.0)):
+            for old in (stem + ".1.ele", stem + ".1.node", stem + ".1.face", stem + ".1.edge"):
+                if os.path.exists(old):
+                    os.remove(old)
+            start = time.time()
+            r = subprocess.run([tetgen, switches, smesh], stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+            seconds = time.time() - start
+            ele = stem + ".1.ele"
+            tets = 0
+            if os.path.exists(ele):
+                with open(ele) as f:
+                    tets = int(f.readline().split()[0])
+            ok = r.returncode == 0 and tets > 0
+            volume_note = ""
+            if ok:
+                # the tetrahedra fill the space between the cage and the input
+                meshed = tet_volume(stem + ".1.node", ele)
+                volume_ok = abs(meshed - between) <= tolerance + extra
+                volume_note = ", volume %.9g (cage - input %.9g, difference %.3g, allowed %.3g: %d cage edge(s) " \
+                    "within 0.1 degree of flat)" % (meshed, between, meshed - between, tolerance + extra, flat_edges)
+                if len(holes) > 0 and not volume_ok:
+                    ok = False
+            print("%s: %s cage %d vertices: tetgen %s exit %d, %d tetrahedra, %.1f s%s" %
+                  ("ok  " if ok else "FAIL", optimize, len(cage[0]), switches, r.returncode, tets, seconds, volume_note))
+            if not ok:
+                print(r.stdout[-2000:])
+                failures += 1
     return 1 if failures else 0
 
 

@@ -731,6 +731,22 @@ int TestParameters(const Context&)
   CheckSuccessfulRun(c, explicitFilter, input);
   c.Check(explicitFilter->GetVoxelSizeUsed() <= 0.02 + 1e-12, "VoxelSizeUsed <= VoxelSize");
 
+  // CoarseFirst (default = Core's): on, the closed sphere without active points keeps the envelope
+  // of the grid of c (voxel = IsoValue); off, the automatic grid c/2 is sampled directly
+  c.Check((filter->GetCoarseFirst() != 0) == core.CoarseFirst, "CoarseFirst default = Core's");
+  for (const int coarseFirst : { 1, 0 })
+  {
+    vtkNew<vtkSDFCageFilter> grid;
+    grid->SetInputData(input);
+    grid->SetTargetNumberOfVertices(50);
+    grid->SetCoarseFirst(coarseFirst);
+    grid->Update();
+    CheckSuccessfulRun(c, grid, input);
+    const double expected = coarseFirst ? core.IsoValue : core.IsoValue / 2;
+    c.Check(std::abs(grid->GetVoxelSizeUsed() - expected) < 1e-12,
+      coarseFirst ? "CoarseFirst on: the sphere keeps the grid of c" : "CoarseFirst off: the grid of c/2");
+  }
+
   // Thread count does not change the result.
   vtkNew<vtkSDFCageFilter> allThreads;
   allThreads->SetInputData(input);
