@@ -36,4 +36,4 @@ stage() {
 # The sanitizer tests (.ci/asan.sh) are run by hand for now: their fast part was narrowed this
 # session and has not yet completed from a fresh clone; once timed, they join as
 #   stage "sanitizer tests (.ci/asan.sh)" 1500 bash .ci/asan.sh
-stage "plain VTK build (.ci/plain-vtk.sh)" 1500 bash .ci/plain-vtk.sh
+stage "plain VTK build (.ci/plain-vtk.sh)" 1800 bash .ci/plain-vtk.sh
