@@ -130,7 +130,7 @@ std::vector<std::uint64_t> uniqueEdgeKeys(const TriangleMesh& mesh, const std::v
 }
 } // namespace
 
-long long eulerCharacteristic(const TriangleMesh& mesh)
+long long usedVertexCount(const TriangleMesh& mesh)
 {
   std::vector<char> used(mesh.Points.size(), 0);
   long long v = 0;
@@ -145,6 +145,12 @@ long long eulerCharacteristic(const TriangleMesh& mesh)
       }
     }
   }
+  return v;
+}
+
+long long eulerCharacteristic(const TriangleMesh& mesh)
+{
+  const long long v = usedVertexCount(mesh);
   const long long e = static_cast<long long>(uniqueEdgeKeys(mesh, nullptr).size());
   return v - e + static_cast<long long>(mesh.Triangles.size());
 }

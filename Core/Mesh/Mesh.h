@@ -56,6 +56,9 @@ int triangleComponents(const TriangleMesh& mesh, std::vector<int>& componentOfTr
 /// points decide enclosure (verification) and must never be swept across (simplification).
 std::vector<Vec3> componentProbes(const TriangleMesh& mesh);
 
+/// Number of distinct points referenced by at least one triangle.
+long long usedVertexCount(const TriangleMesh& mesh);
+
 /// Euler characteristic V - E + F counted over referenced vertices and unique undirected edges.
 long long eulerCharacteristic(const TriangleMesh& mesh);
 

@@ -467,17 +467,9 @@ bool checkTopology(const TriangleMesh& mesh, MeshDefects& d, Progress* progress 
 
 int closedManifoldGenus(const TriangleMesh& mesh, int components)
 {
-  std::vector<char> used(mesh.Points.size(), 0);
-  long long v = 0;
-  for (const Triangle& t : mesh.Triangles)
-    for (int i : t)
-      if (!used[i])
-      {
-        used[i] = 1;
-        ++v;
-      }
+  // a closed 2-manifold has E = 3F/2: no sort of the edges is needed
   const long long f = static_cast<long long>(mesh.Triangles.size());
-  const long long chi = v - 3 * f / 2 + f;
+  const long long chi = usedVertexCount(mesh) - 3 * f / 2 + f;
   return static_cast<int>((2LL * components - chi) / 2);
 }
 

@@ -130,26 +130,8 @@ def main():
         d.LineWidth = 2.0
     labels.append("a cut through all levels")
 
-    Render(view)
-    aspect = float(width_px) / height_px
-    span = (panels - 1) * shift + size[0]
-    scale = builtins.max(0.62 * size[1], 0.52 * span / aspect)
-    focal = [centre[0] + 0.5 * (panels - 1) * shift, centre[1] - 0.04 * size[1], centre[2]]
-    view.CameraParallelProjection = 1
-    view.CameraFocalPoint = focal
-    view.CameraPosition = [focal[0], focal[1], focal[2] + 10.0 * span]
-    view.CameraViewUp = [0.0, 1.0, 0.0]
-    view.CameraParallelScale = scale
-    for k, label in enumerate(labels):
-        t = Show(Text(Text=label), view)
-        t.WindowLocation = "Any Location"
-        t.Justification = "Center"
-        t.Position = [(k + 0.5) / panels - 0.09, 0.9]
-        t.FontSize = 18
-        t.Color = [0.1, 0.1, 0.1]
-    Render(view)
-    SaveScreenshot(args.screenshot, view, ImageResolution=[width_px, height_px])
-    print("screenshot     : %s" % args.screenshot)
+    ex.frame_and_save(view, bounds, shift, labels, (width_px, height_px), args.screenshot,
+                      fill=(0.62, 0.52), lift=-0.04, label_dx=0.09, font=18)
     Delete(view)
     del view
     return 0 if ok else 1

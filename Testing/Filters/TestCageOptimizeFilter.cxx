@@ -19,21 +19,33 @@
 namespace sdfcage_test
 {
 
+namespace
+{
+// The 150-vertex cage of a sphere that the tests below optimize, made by `cager` (the caller keeps
+// it: TestOptimizeFilter runs it again with its own Optimize step).
+bool BuildSphereCage(Checker& c, vtkSDFCageFilter* cager, vtkSmartPointer<vtkPolyData>& sphere)
+{
+  sphere = MakeSphere(1.0, 24);
+  cager->SetInputData(sphere);
+  cager->SetTargetNumberOfVertices(150);
+  cager->Update();
+  return c.Check(
+    std::string(cager->GetStatusString()) == "Ok" && cager->GetOutput(0)->GetNumberOfPoints() == 150,
+    "the cage to optimize was built");
+}
+} // namespace
+
 int TestOptimizeFilter(const Context&)
 {
   Checker c("OptimizeFilter");
   // a cage of a sphere from vtkSDFCageFilter, then optimized with both energies
-  vtkSmartPointer<vtkPolyData> sphere = MakeSphere(1.0, 24);
+  vtkSmartPointer<vtkPolyData> sphere;
   vtkNew<vtkSDFCageFilter> cager;
-  cager->SetInputData(sphere);
-  cager->SetTargetNumberOfVertices(150);
-  cager->Update();
-  vtkPolyData* cage = cager->GetOutput(0);
-  if (!c.Check(std::string(cager->GetStatusString()) == "Ok" && cage->GetNumberOfPoints() == 150,
-        "the cage to optimize was built"))
+  if (!BuildSphereCage(c, cager, sphere))
   {
     return c.Result();
   }
+  vtkPolyData* cage = cager->GetOutput(0);
 
   vtkNew<vtkCageOptimizeFilter> filter;
   const sdfcage::OptimizeOptions defaults;
@@ -132,17 +144,13 @@ int TestOptimizeFilter(const Context&)
 int TestOptimizeTightOptions(const Context&)
 {
   Checker c("OptimizeTightOptions");
-  vtkSmartPointer<vtkPolyData> sphere = MakeSphere(1.0, 24);
+  vtkSmartPointer<vtkPolyData> sphere;
   vtkNew<vtkSDFCageFilter> cager;
-  cager->SetInputData(sphere);
-  cager->SetTargetNumberOfVertices(150);
-  cager->Update();
-  vtkPolyData* cage = cager->GetOutput(0);
-  if (!c.Check(std::string(cager->GetStatusString()) == "Ok" && cage->GetNumberOfPoints() == 150,
-        "the cage to optimize was built"))
+  if (!BuildSphereCage(c, cager, sphere))
   {
     return c.Result();
   }
+  vtkPolyData* cage = cager->GetOutput(0);
   const sdfcage::OptimizeOptions defaults;
   vtkNew<vtkCageOptimizeFilter> filter;
   c.Check(filter->GetHausdorffFactor() == defaults.HausdorffFactor, "HausdorffFactor default is Core's");
