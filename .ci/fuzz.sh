@@ -32,7 +32,9 @@ for harness in "${harnesses[@]}"; do
   regressions="Testing/Fuzz/regressions/$harness"
   if [ -d "$regressions" ] && [ -n "$(ls -A "$regressions")" ]; then
     echo "== $harness: replaying $(ls "$regressions" | wc -l) regression input(s)"
-    if ! "$exe" "${options[@]}" "$regressions"/*; then
+    # the kept inputs are known to be slow, not hung: a replay may take 4x the limit (a load of 6-7,
+    # as with three other builds running, made the 31-s input take 223 s)
+    if ! "$exe" "${options[@]}" -timeout=$((4 * limit)) "$regressions"/*; then
       echo "FAILED: $harness on a kept regression input"
       status=1
       continue
