@@ -526,7 +526,6 @@ private:
     std::vector<char> IsCandidate;           // 0 outside testSample()
     std::vector<int> Candidates;             // of the sample being tested
     std::vector<int> Unsettled, Certifiable; // near the ball being certified
-    std::vector<std::pair<double, int>> UnsettledByX;
     std::vector<std::pair<int, double>> AlongOf; // facing-gap rule: candidates settled, distance
   };
 
@@ -566,22 +565,12 @@ private:
             }
           });
           const double r2 = r * r;
-          // the unsettled points by x: each certifiable one looks only at those within r in x
-          s.UnsettledByX.clear();
-          for (int u : s.Unsettled)
-          {
-            s.UnsettledByX.emplace_back(this->Points[u].x(), u);
-          }
-          std::sort(s.UnsettledByX.begin(), s.UnsettledByX.end());
           for (int q : s.Certifiable)
           {
             bool ok = true;
-            const Vec3& xq = this->Points[q];
-            auto it = std::lower_bound(s.UnsettledByX.begin(), s.UnsettledByX.end(),
-              std::make_pair(xq.x() - r, std::numeric_limits<int>::min()));
-            for (; it != s.UnsettledByX.end() && it->first <= xq.x() + r; ++it)
+            for (int u : s.Unsettled)
             {
-              if ((this->Points[it->second] - xq).squaredNorm() < r2)
+              if ((this->Points[u] - this->Points[q]).squaredNorm() < r2)
               {
                 ok = false;
                 break;

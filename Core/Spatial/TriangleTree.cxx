@@ -315,13 +315,6 @@ double TriangleTree::triangleQuery(const Vec3 t[3], double limit, bool stopAtFir
     for (int i = n.Start; i < n.Start + n.Count; ++i)
     {
       const Tri3& o = Tri[i];
-      // the boxes first (a lower bound; the margin keeps rounding from skipping a triangle the
-      // exact distance would take)
-      if (boxBoxDistance2(o.P[0].cwiseMin(o.P[1]).cwiseMin(o.P[2]), o.P[0].cwiseMax(o.P[1]).cwiseMax(o.P[2]), tlo,
-            thi) >= best * best * (1.0 + 1e-9))
-      {
-        continue;
-      }
       if (hasPlane)
       {
         const double s0 = normal.dot(o.P[0]) - offset, s1 = normal.dot(o.P[1]) - offset,
