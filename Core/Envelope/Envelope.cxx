@@ -319,13 +319,38 @@ std::size_t projectOntoAmplifiedOffset(
     const std::size_t before = envelope.Points.size();
     // only chords that sag: where the offset surface curves (around rims and edges of the
     // input) its chords come closer to the input than their ends; flat parts are left alone
-    const std::size_t created = splitEdges(envelope, [&](int a, int b) {
-      if (!(amplified[a] && amplified[b]) || (envelope.Points[a] - envelope.Points[b]).squaredNorm() <= m2)
+    // The candidate edges (both ends moved, longer than maxEdge) are measured once each, on all
+    // threads, with the search bounded by what decides (the midpoint nearer than the bound);
+    // splitEdges then looks the answers up.
+    std::vector<std::uint64_t> candidates;
+    for (const Triangle& t : envelope.Triangles)
+      for (int k = 0; k < 3; ++k)
       {
-        return false;
+        const int a = t[k], b = t[(k + 1) % 3];
+        if (a < b && amplified[a] && amplified[b] && (envelope.Points[a] - envelope.Points[b]).squaredNorm() > m2)
+          candidates.push_back((static_cast<std::uint64_t>(a) << 32) | static_cast<std::uint32_t>(b));
       }
-      const double sag = tree.distance(0.5 * (envelope.Points[a] + envelope.Points[b]));
-      return sag < 0.9 * std::min(offset[a], offset[b]);
+    std::sort(candidates.begin(), candidates.end());
+    candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
+    std::vector<char> sags(candidates.size(), 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, candidates.size(), 256),
+      [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i)
+        {
+          const int a = static_cast<int>(candidates[i] >> 32), b = static_cast<int>(candidates[i] & 0xFFFFFFFFu);
+          const double bound = 0.9 * std::min(offset[a], offset[b]);
+          Vec3 cp;
+          int t = -1;
+          double d = 0.0;
+          sags[i] = bound > 0.0 &&
+            tree.closestPoint(0.5 * (envelope.Points[a] + envelope.Points[b]), bound, cp, t, d) && d < bound;
+        }
+      });
+    const std::size_t created = splitEdges(envelope, [&](int a, int b) {
+      const std::uint64_t key =
+        (static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint32_t>(std::max(a, b));
+      const auto it = std::lower_bound(candidates.begin(), candidates.end(), key);
+      return it != candidates.end() && *it == key && sags[it - candidates.begin()] != 0;
     });
     if (created == 0)
     {

@@ -170,21 +170,38 @@ bool TriangleTree::closestPoint(const Vec3& p, double maxDistance, Vec3& closest
     return false;
   }
   double best2 = maxDistance < 0 ? std::numeric_limits<double>::infinity() : maxDistance * maxDistance;
-  int stack[128];
+  // Each entry keeps its box distance, measured when its parent was opened: popped nodes are
+  // tested against the current best without measuring again (the same nodes are visited, in the
+  // same order, as when each box was measured on popping).
+  struct Pending
+  {
+    int Node;
+    double D2;
+  };
+  Pending stack[128];
   int top = 0;
-  stack[top++] = 0;
+  stack[top++] = { 0, boxPointDistance2(Nodes[0].Lo, Nodes[0].Hi, p) };
   while (top)
   {
-    const Node& n = Nodes[stack[--top]];
-    if (boxPointDistance2(n.Lo, n.Hi, p) > best2)
+    const Pending e = stack[--top];
+    if (e.D2 > best2)
     {
       continue;
     }
+    const Node& n = Nodes[e.Node];
     if (n.Left < 0)
     {
       for (int i = n.Start; i < n.Start + n.Count; ++i)
       {
-        const Vec3 q = closestPointOnTriangle(p, Tri[i].P[0], Tri[i].P[1], Tri[i].P[2]);
+        const Vec3* P = Tri[i].P;
+        // the triangle's own box first: nothing in it is nearer than the box (the margin keeps
+        // rounding in the closest point from ever making this skip a triangle it would take)
+        const Vec3 lo = P[0].cwiseMin(P[1]).cwiseMin(P[2]), hi = P[0].cwiseMax(P[1]).cwiseMax(P[2]);
+        if (boxPointDistance2(lo, hi, p) > best2 * (1.0 + 1e-9))
+        {
+          continue;
+        }
+        const Vec3 q = closestPointOnTriangle(p, P[0], P[1], P[2]);
         const double d2 = (q - p).squaredNorm();
         if (d2 < best2 || (triangle < 0 && d2 <= best2))
         {
@@ -200,13 +217,13 @@ bool TriangleTree::closestPoint(const Vec3& p, double maxDistance, Vec3& closest
     const double dr = boxPointDistance2(Nodes[n.Right].Lo, Nodes[n.Right].Hi, p);
     if (dl < dr)
     {
-      stack[top++] = n.Right;
-      stack[top++] = n.Left;
+      stack[top++] = { n.Right, dr };
+      stack[top++] = { n.Left, dl };
     }
     else
     {
-      stack[top++] = n.Left;
-      stack[top++] = n.Right;
+      stack[top++] = { n.Left, dl };
+      stack[top++] = { n.Right, dr };
     }
   }
   if (triangle < 0)

@@ -326,6 +326,54 @@ TEST(Optimization, TreeTriangleQueriesMatchBruteForce)
   EXPECT_GT(within, 30) << "the random queries must exercise non-empty answers";
 }
 
+TEST(Optimization, TreeClosestPointMatchesBruteForce)
+{
+  // closestPoint's pruning (node boxes kept on the stack, each triangle's box before its closest
+  // point) must not change the answer: the nearest distance, bounded and unbounded, and whether
+  // anything lies within the bound, against a brute-force loop
+  const TriangleMesh mesh = makeTorus(Vec3(0, 0, 0), 1.0, 0.3, 48, 16);
+  const TriangleTree tree(mesh);
+  unsigned seed = 4242;
+  auto uniform = [&]() {
+    seed = seed * 1664525u + 1013904223u;
+    return (seed >> 8) / double(1u << 24);
+  };
+  int inside = 0, outside = 0;
+  for (int trial = 0; trial < 500; ++trial)
+  {
+    const Vec3 p(3.0 * uniform() - 1.5, 3.0 * uniform() - 1.5, 1.0 * uniform() - 0.5);
+    double brute = std::numeric_limits<double>::infinity();
+    for (const Triangle& t : mesh.Triangles)
+    {
+      const Vec3 q = closestPointOnTriangle(p, mesh.Points[t[0]], mesh.Points[t[1]], mesh.Points[t[2]]);
+      brute = std::min(brute, (q - p).norm());
+    }
+    EXPECT_DOUBLE_EQ(tree.distance(p), brute) << trial;
+    const double bound = 0.2 * uniform();
+    Vec3 c;
+    int tri = -1;
+    double d = -1;
+    const bool found = tree.closestPoint(p, bound, c, tri, d);
+    EXPECT_EQ(found, brute <= bound) << trial;
+    if (found)
+    {
+      ++inside;
+      EXPECT_DOUBLE_EQ(d, brute) << trial;
+      EXPECT_NEAR((c - p).norm(), d, 1e-12) << trial;
+      ASSERT_GE(tri, 0);
+      const Triangle& t = mesh.Triangles[tri];
+      const Vec3 q = closestPointOnTriangle(p, mesh.Points[t[0]], mesh.Points[t[1]], mesh.Points[t[2]]);
+      EXPECT_DOUBLE_EQ((q - p).norm(), brute) << trial;
+    }
+    else
+    {
+      ++outside;
+    }
+  }
+  EXPECT_GT(inside, 30) << "the random queries must find points within the bound";
+  EXPECT_GT(outside, 30) << "and miss it";
+}
+
 TEST(Optimization, DeterministicAcrossThreadCounts)
 {
   // the relocation runs batches of non-overlapping vertex regions in parallel: the result must
