@@ -343,14 +343,7 @@ TEST(AnyMeshWidening, OffKeepsTheIsovalueOnReportsTheWiderEnvelope)
   EXPECT_TRUE(on.EnclosureVerified);
   EXPECT_EQ(on.EnvelopeProbes, 0);
   EXPECT_EQ(on.EnvelopeAttempts, on.EnvelopeWidenings + 1);
-  // the default (probes first: 81 parts are more than 100 vertices can carry apart) reaches it too
-  options.ChooseIsoValueFirst = true;
-  const CageResult probed = generateCage(input, options);
-  ASSERT_EQ(probed.State, Status::Ok) << probed.Message;
-  EXPECT_TRUE(probed.TargetReached) << probed.StopReason;
-  EXPECT_TRUE(probed.EnclosureVerified);
-  EXPECT_GE(probed.EnvelopeProbes, 1) << probed.WideningLog;
-  EXPECT_EQ(probed.IsoValueUsed, options.Envelope.IsoValue * (1 << probed.EnvelopeWidenings));
+  // (the default, probes first, on this input: the AnyMesh case SphereWithDebris)
   // a closed input is never widened, whatever its target
   CageOptions closed;
   closed.TargetNumberOfVertices = 5; // a torus cannot have 5 vertices
