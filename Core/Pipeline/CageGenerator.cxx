@@ -19,6 +19,10 @@ namespace sdfcage
 
 namespace
 {
+/// Probes (CageOptions::ChooseIsoValueFirst) use grids this many times as coarse as the
+/// automatic voxel size of their isovalue.
+constexpr double ProbeVoxelFactor = 2.0;
+
 double seconds(std::chrono::steady_clock::time_point t0)
 {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -38,40 +42,67 @@ ScalarImage imageToInput(ScalarImage image, const Normalization& n)
 
 namespace
 {
-/// One run of the pipeline. `mayWiden`: a wider envelope will be tried if this one cannot carry
-/// the target, so an envelope whose topology needs more vertices than the target is not
-/// simplified (it could not reach the target; the time is better spent on the wider one).
-CageResult generateOnce(const PolygonMesh& input, const CageOptions& options, Progress* progress, bool mayWiden)
+/// The input, validated, repaired and normalized once for every run of generateCage.
+struct PreparedInput
 {
-  CageResult result;
-  result.IsoValueUsed = options.Envelope.IsoValue;
-  const auto start = std::chrono::steady_clock::now();
-  const ThreadLimit threads(options.NumberOfThreads);
+  MeshDefects Defects;
+  double ValidationSeconds = 0.0;
+  Normalization Normalize;
+  TriangleMesh Unit; ///< the repaired input in unit-sphere units
+};
 
+/// Validation and normalization (steps 1 and 2 of every run). False (with `failed` filled) when
+/// the input cannot be used or the run was cancelled.
+bool prepareInput(const PolygonMesh& input, const CageOptions& options, Progress* progress, PreparedInput& prepared,
+  CageResult& failed)
+{
+  const auto start = std::chrono::steady_clock::now();
   // 1. validation
   progressStage(progress, "validating input", 0.0, 0.02);
   TriangleMesh mesh;
-  result.Defects = prepareMesh(input, mesh, options.Validation, progress);
-  result.ValidationSeconds = seconds(start);
+  prepared.Defects = prepareMesh(input, mesh, options.Validation, progress);
+  prepared.ValidationSeconds = seconds(start);
+  failed.IsoValueUsed = options.Envelope.IsoValue;
+  failed.Defects = prepared.Defects;
+  failed.ValidationSeconds = prepared.ValidationSeconds;
+  failed.TotalSeconds = seconds(start);
   if (progressCancelled(progress))
   {
-    result.State = Status::Cancelled;
-    result.Message = "cancelled";
-    return result;
+    failed.State = Status::Cancelled;
+    failed.Message = "cancelled";
+    return false;
   }
-  if (!result.Defects.usableAsInput())
+  if (!prepared.Defects.usableAsInput())
   {
-    const bool nothing =
-      result.Defects.Empty && result.Defects.NonFinitePoints == 0 && result.Defects.InvalidPointIds == 0;
-    result.State = nothing ? Status::EmptyInput : Status::InvalidInput;
-    result.Message = result.Defects.inputErrorMessage();
-    return result;
+    const bool nothing = prepared.Defects.Empty && prepared.Defects.NonFinitePoints == 0 &&
+      prepared.Defects.InvalidPointIds == 0;
+    failed.State = nothing ? Status::EmptyInput : Status::InvalidInput;
+    failed.Message = prepared.Defects.inputErrorMessage();
+    return false;
   }
-
   // 2. normalization into the unit sphere: every length parameter is relative to it
-  result.Normalize = Normalization::fit(mesh);
+  prepared.Normalize = Normalization::fit(mesh);
+  prepared.Unit = prepared.Normalize.toUnit(mesh);
+  return true;
+}
+
+/// One run of the pipeline on the prepared input. `mayWiden`: a wider envelope will be tried if
+/// this one cannot carry the target, so an envelope whose topology needs more vertices than the
+/// target is not simplified (it could not reach the target; the time is better spent on the
+/// wider one), nor is a simplification pursued past its ordinary pass when that ends well above
+/// the target (SimplifyOptions::GiveUpAbove).
+CageResult generateOnce(
+  const PreparedInput& prepared, const CageOptions& options, Progress* progress, bool mayWiden)
+{
+  CageResult result;
+  result.IsoValueUsed = options.Envelope.IsoValue;
+  result.EnvelopeAttempts = 1;
+  const auto start = std::chrono::steady_clock::now();
+  result.Defects = prepared.Defects;
+  result.ValidationSeconds = prepared.ValidationSeconds;
+  result.Normalize = prepared.Normalize;
   const Normalization& n = result.Normalize;
-  const TriangleMesh unit = n.toUnit(mesh);
+  const TriangleMesh& unit = prepared.Unit;
 
   // 3. the verified envelope
   // when the dense envelope is itself the cage, its exact clearance is the one to report
@@ -168,6 +199,12 @@ CageResult generateOnce(const PolygonMesh& input, const CageOptions& options, Pr
     SimplifyOptions so = options.Simplify;
     so.TargetNumberOfVertices = options.TargetNumberOfVertices;
     so.Clearance = env.ClearanceUsed > 0 ? env.ClearanceUsed : options.Envelope.clearance();
+    if (mayWiden && !env.InputClosed)
+    {
+      // the thorough passes rescue a few percent at most (soup: 657 -> 509, truck: 1,673 ->
+      // 1,274 for a target of 500) and take most of the time of a cage that ends short
+      so.GiveUpAbove = WideningGiveUpAbove(options.TargetNumberOfVertices);
+    }
     progressStage(progress, "simplifying", 0.45, 0.95);
     const std::vector<Vec3> probes = componentProbes(unit);
     result.Simplification = simplifyEnvelope(env.Envelope, tree, so, progress, &probes);
@@ -255,19 +292,128 @@ CageResult generateOnce(const PolygonMesh& input, const CageOptions& options, Pr
   return result;
 }
 
-/// Should the envelope be widened (see CageOptions::MaximumEnvelopeWidenings)?
-bool wantsWidening(const CageResult& r, const CageOptions& options, int done, Progress* progress)
+/// Should the envelope be widened (see CageOptions::MaximumEnvelopeWidenings)? `left`: the
+/// widenings still allowed.
+bool wantsWidening(const CageResult& r, const CageOptions& options, int left, Progress* progress)
 {
-  return done < options.MaximumEnvelopeWidenings && options.TargetNumberOfVertices > 0 &&
+  return left > 0 && options.TargetNumberOfVertices > 0 &&
     ((r.State == Status::Ok && !r.TargetReached) || r.EnvelopeTooComplex) && !r.InputClosed &&
     !progressCancelled(progress);
 }
+
+/// One coarse-grid probe (CageOptions::ChooseIsoValueFirst): the envelope at `isoValue` on a
+/// grid of voxel ProbeVoxelFactor x `isoValue` / 2, extracted but neither verified nor
+/// simplified (a vertex budget of 1 stops every extraction at its parts and genus).
+struct Probe
+{
+  bool Ran = false; ///< false: cancelled or failed (the probing stops, nothing is skipped)
+  int Components = 0;
+  int Genus = 0;
+  double Seconds = 0.0;
+};
+
+Probe probeEnvelope(const TriangleMesh& unit, const EnvelopeOptions& requested, double isoValue, Progress* progress)
+{
+  const auto t0 = std::chrono::steady_clock::now();
+  EnvelopeOptions o = requested;
+  o.IsoValue = isoValue;
+  o.VoxelSize = ProbeVoxelFactor * o.voxelSize();
+  o.MinimumClearance = requested.MinimumClearance > 0 ? requested.MinimumClearance : isoValue / 4;
+  o.VertexBudget = 1;
+  o.MaximumRefinements = 0;
+  o.KeepDistanceField = false;
+  o.ExactEnvelopeClearance = false;
+  o.CoarseFirst = false;
+  o.MaximumTopologyRepairs = 0;
+  Probe p;
+  const EnvelopeResult env = buildEnvelope(unit, o, progress, 1.0, 0);
+  p.Seconds = seconds(t0);
+  if (env.TooComplex && !progressCancelled(progress))
+  {
+    p.Ran = true;
+    p.Components = env.Components;
+    p.Genus = env.Genus;
+  }
+  return p;
+}
 } // namespace
+
+int WideningGiveUpAbove(int target)
+{
+  return target + std::max(8, target / 5);
+}
 
 CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Progress* progress)
 {
   const auto start = std::chrono::steady_clock::now();
-  CageResult best = generateOnce(input, options, progress, options.MaximumEnvelopeWidenings > 0);
+  const ThreadLimit threads(options.NumberOfThreads);
+  PreparedInput prepared;
+  {
+    CageResult failed;
+    if (!prepareInput(input, options, progress, prepared, failed))
+    {
+      return failed;
+    }
+  }
+  std::string log;
+  // The isovalue chosen first (CageOptions::ChooseIsoValueFirst), on coarse grids, for an input
+  // of more parts than the target can carry apart (4 vertices each): its envelope reaches the
+  // target only where the isovalue fuses them. From the widest isovalue below the last one
+  // down, each probe that can carry the target lowers the choice; the first that cannot stops
+  // the probing (a narrower envelope keeps even more apart). The widest allowed isovalue is
+  // never probed: the widening ends there anyway.
+  CageOptions first = options;
+  int skipped = 0;
+  int probes = 0;
+  double probeSeconds = 0.0;
+  const int maxWidenings = options.MaximumEnvelopeWidenings;
+  if (options.ChooseIsoValueFirst && maxWidenings > 0 && options.TargetNumberOfVertices > 0 &&
+    !prepared.Defects.usable() && !(options.Envelope.VoxelSize > 0) && options.Envelope.Sign != SignMode::FloodFill &&
+    minimumCageVertices(static_cast<int>(prepared.Defects.Components), 0) > options.TargetNumberOfVertices)
+  {
+    progressStage(progress, "choosing the isovalue on coarse grids", 0.0, 1.0);
+    skipped = maxWidenings; // the widest isovalue unless a probe can carry the target
+    for (int k = maxWidenings - 1; k >= 0 && !progressCancelled(progress); --k)
+    {
+      const double iso = options.Envelope.IsoValue * static_cast<double>(1 << k);
+      const Probe p = probeEnvelope(prepared.Unit, options.Envelope, iso, progress);
+      ++probes;
+      probeSeconds += p.Seconds;
+      if (!p.Ran)
+      {
+        skipped = k; // failed (not cancelled): from here, as without probes
+        break;
+      }
+      const int needed = minimumCageVertices(p.Components, p.Genus);
+      const bool carries = needed <= options.TargetNumberOfVertices;
+      std::ostringstream s;
+      s << (log.empty() ? "" : "; ") << "isovalue " << iso << " probed on a grid of voxel "
+        << ProbeVoxelFactor * iso / 2 << ": envelope of " << p.Components << " part(s), genus " << p.Genus
+        << ", needs about " << needed << " vertices" << (carries ? "" : ": not built") << " (" << std::setprecision(3)
+        << p.Seconds << " s)";
+      log += s.str();
+      if (!carries)
+      {
+        break;
+      }
+      skipped = k;
+    }
+    first.Envelope.IsoValue = options.Envelope.IsoValue * static_cast<double>(1 << skipped);
+  }
+  if (progressCancelled(progress))
+  {
+    CageResult cancelled;
+    cancelled.State = Status::Cancelled;
+    cancelled.Message = "cancelled";
+    cancelled.Defects = prepared.Defects;
+    cancelled.ValidationSeconds = prepared.ValidationSeconds;
+    cancelled.WideningLog = log;
+    cancelled.TotalSeconds = seconds(start);
+    return cancelled;
+  }
+  const int allowed = options.MaximumEnvelopeWidenings - skipped; // fine-grid widenings left
+  CageResult best = generateOnce(prepared, first, progress, allowed > 0);
+  int attempts = 1;
   // A cage simplified from the coarse grid's envelope (EnvelopeOptions::CoarseFirst) that misses
   // its target (small targets: the coarse envelope's merged polygons leave the simplifier fewer
   // placements) is made again from the requested grid's envelope; the one with fewer vertices
@@ -279,37 +425,49 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
     CageOptions requested = options;
     requested.Envelope.CoarseFirst = false;
     progressStage(progress, "the envelope on the requested grid, to reach the target", 0.0, 1.0);
-    CageResult next = generateOnce(input, requested, progress, options.MaximumEnvelopeWidenings > 0);
+    CageResult next = generateOnce(prepared, requested, progress, options.MaximumEnvelopeWidenings > 0);
+    ++attempts;
     if (next.State == Status::Cancelled || (next.State == Status::Ok && next.VerticesReached < best.VerticesReached))
     {
       best = std::move(next);
     }
   }
-  CageOptions wider = options;
+  if (skipped > 0 && best.State != Status::Cancelled)
+  {
+    best.EnvelopeWidenings = skipped;
+  }
+  CageOptions wider = first;
   int tried = 0;
-  std::string log;
   auto note = [&log](const CageResult& r) {
     std::ostringstream s;
     s << (log.empty() ? "" : "; ") << "isovalue " << r.IsoValueUsed << ": envelope of " << r.EnvelopeComponents
       << " part(s), genus " << r.EnvelopeGenus << ", "
       << (r.EnvelopeTooComplex ? std::string("not simplified") : std::to_string(r.VerticesReached) + " vertices")
-      << " (" << std::setprecision(3) << r.TotalSeconds << " s)";
+      << (r.Simplification.GaveUp ? " after the ordinary pass" : "") << " (" << std::setprecision(3)
+      << r.TotalSeconds << " s: field " << r.DistanceFieldSeconds << " of which sign " << r.WindingSeconds
+      << ", isosurface " << r.IsosurfaceSeconds << ", verification " << r.VerificationSeconds
+      << ", simplification " << r.SimplificationSeconds << ")";
     log += s.str();
   };
-  for (int k = 0; wantsWidening(best, options, k, progress); ++k)
+  if (skipped > 0)
   {
-    if (k == 0)
+    note(best);
+  }
+  for (int k = 0; wantsWidening(best, options, allowed - k, progress); ++k)
+  {
+    if (k == 0 && skipped == 0)
       note(best);
     tried = k + 1;
     wider.Envelope.IsoValue *= 2.0;
     progressStage(progress, "widening the envelope to reach the target", 0.0, 1.0);
-    CageResult next = generateOnce(input, wider, progress, k + 1 < options.MaximumEnvelopeWidenings);
+    CageResult next = generateOnce(prepared, wider, progress, k + 1 < allowed);
+    ++attempts;
     note(next);
     // keep the cage that reaches the target, or the one closest to it (on a tie, the tighter first one)
     if ((next.State == Status::Ok || next.EnvelopeTooComplex) &&
       (best.EnvelopeTooComplex || next.VerticesReached < best.VerticesReached))
     {
-      next.EnvelopeWidenings = k + 1;
+      next.EnvelopeWidenings = skipped + k + 1;
       next.StopReason = next.TargetReached ? std::string() : next.StopReason;
       best = std::move(next);
     }
@@ -318,12 +476,16 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
       break;
     }
   }
-  if (tried > 0 && !best.TargetReached && best.State == Status::Ok)
+  if ((tried > 0 || skipped > 0) && !best.TargetReached && best.State == Status::Ok)
   {
-    best.StopReason +=
-      "; the envelope was widened " + std::to_string(tried) + " time(s), the cage with the fewest vertices is kept";
+    best.StopReason += "; the envelope was widened " + std::to_string(tried + skipped) +
+      " time(s), the cage with the fewest vertices is kept";
   }
   best.WideningLog = log;
+  best.EnvelopeProbes = probes;
+  best.IsoValuesSkipped = skipped;
+  best.ProbeSeconds = probeSeconds;
+  best.EnvelopeAttempts = attempts;
   best.TotalSeconds = seconds(start);
   return best;
 }

@@ -31,9 +31,24 @@ struct CageOptions
   /// with twice the isovalue (the automatic voxel size and clearance follow it), which fuses
   /// parts and closes handles narrower than about twice the new isovalue, up to this many
   /// times (2, 4, 8 times the isovalue); the cage that reaches the target (or gets closest) is kept and IsoValueUsed /
-  /// EnvelopeWidenings say what was done. Closed inputs are never widened (their topology is
+  /// EnvelopeWidenings say what was done. An envelope that a wider one may still replace is not
+  /// simplified past its ordinary pass when that ends above WideningGiveUpAbove(target)
+  /// vertices (the thorough passes that follow rescue a few percent at most and cost most of
+  /// the time of a cage that ends short). Closed inputs are never widened (their topology is
   /// kept). 0 = off.
   int MaximumEnvelopeWidenings = 3;
+  /// With widening on, the automatic voxel size and an input of more parts than the target can
+  /// carry apart (4 vertices each: its envelope reaches the target only where the isovalue
+  /// fuses them), the isovalue is chosen before any envelope is built on the requested grid, by
+  /// probes on grids twice as coarse (voxel = the isovalue; distance field, sign and isosurface,
+  /// neither verified nor simplified): from the widest isovalue below the last one down, each
+  /// probe whose envelope's parts and handles may fit the target (minimumCageVertices) lowers
+  /// the choice, and the first that cannot stops the probing. The envelope is then built on the
+  /// requested grid at the chosen isovalue and widened from there as before. The probe's count
+  /// is an estimate (the coarse grid fuses narrow gaps, and can open handles in slabs thinner
+  /// than its voxel); it only decides which envelopes are not built. Closed inputs are never
+  /// probed.
+  bool ChooseIsoValueFirst = true;
 };
 
 struct CageResult
@@ -93,12 +108,19 @@ struct CageResult
   double OptimizationSeconds = 0.0;
   double TotalSeconds = 0.0;
   double IsoValueUsed = 0.0; ///< unit-sphere units: the requested one, or widened (see MaximumEnvelopeWidenings)
-  int EnvelopeWidenings = 0; ///< envelopes rebuilt with twice the isovalue to reach the target
+  /// Doublings of the isovalue to reach the target: IsoValueUsed = IsoValue x 2^EnvelopeWidenings
+  /// (the isovalues the probes ruled out included, see CageOptions::ChooseIsoValueFirst).
+  int EnvelopeWidenings = 0;
   /// This run's envelope has more parts and handles than the target's vertices can carry, and
   /// was not simplified because a wider one is tried next (see MaximumEnvelopeWidenings).
   bool EnvelopeTooComplex = false;
-  /// One entry per envelope built when widening: isovalue, parts, genus, vertices reached, time.
+  /// One entry per envelope built when widening: isovalue, parts, genus, vertices reached, time
+  /// (probes first, see CageOptions::ChooseIsoValueFirst).
   std::string WideningLog;
+  int EnvelopeProbes = 0;     ///< coarse-grid probes run to choose the isovalue
+  int IsoValuesSkipped = 0;   ///< isovalues the probes ruled out (included in EnvelopeWidenings)
+  double ProbeSeconds = 0.0;  ///< time of the probes
+  int EnvelopeAttempts = 0;   ///< envelopes built on the requested grid (each one full run)
   ScalarImage DistanceField;         ///< input coordinates and units, when requested
   ScalarImage ModifiedDistanceField; ///< phi * xi, input units, when requested and active points exist
   Normalization Normalize;
@@ -106,6 +128,11 @@ struct CageResult
 
 /// A field sampled in unit-sphere units, mapped back to input coordinates and lengths.
 ScalarImage imageToInput(ScalarImage image, const Normalization& n);
+
+/// The simplification of an envelope that a wider one may replace stops after its ordinary pass
+/// when that ends above this many vertices (SimplifyOptions::GiveUpAbove): target + max(8,
+/// target / 5).
+int WideningGiveUpAbove(int target);
 
 CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Progress* progress = nullptr);
 

@@ -220,6 +220,11 @@ public:
       const long long before = Stats.Collapses;
       const int excess = AliveVertices - target;
       drain(target, start, r);
+      if (Pass == 0 && Opt.GiveUpAbove > 0 && AliveVertices > Opt.GiveUpAbove && !r.Cancelled)
+      {
+        GaveUp = true; // the caller has a better option than the thorough passes
+        break;
+      }
 
       // progress: try this pass again on what is now blocked (a bounded number of times: each
       // retry runs the thorough search on every blocked edge). Only while a pass removes a fair
@@ -233,12 +238,15 @@ public:
     const bool cancelled = r.Cancelled;
     r = Stats;
     r.Cancelled = cancelled || progressCancelled(Prog);
+    r.GaveUp = GaveUp;
     r.VerticesReached = AliveVertices;
     r.TargetReached = AliveVertices <= target;
     if (!r.TargetReached)
       r.StopReason = r.Cancelled ? "cancelled"
-                                 : "no remaining collapse keeps the clearance, self-intersection, "
-                                   "topology, shape and placement-distance constraints";
+        : GaveUp ? "the ordinary pass ended above " + std::to_string(Opt.GiveUpAbove) +
+            " vertices: the thorough passes were skipped (a wider envelope follows)"
+                 : "no remaining collapse keeps the clearance, self-intersection, "
+                   "topology, shape and placement-distance constraints";
     r.Cage = compact();
     r.Seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return r;
@@ -1001,6 +1009,7 @@ private:
   SimplifyResult Stats;
   int Pass = 0;
   int Retries = 0;
+  bool GaveUp = false; ///< stopped after pass 0 (SimplifyOptions::GiveUpAbove)
   double PlacementReach = std::numeric_limits<double>::infinity();
   static constexpr int MaxRetries = 16;
   LocalChangeVeto Veto; // reads P, T, TAlive and Grid

@@ -39,6 +39,12 @@ struct SimplifyOptions
   /// them is feasible; when the queue runs dry above the target, the blocked edges are retried
   /// with the descent started from all of these and an outward walk along the one-ring normal.
   int PlacementIterations = 8;
+  /// When > 0: if the ordinary pass (every collapse the first queue allows) ends above this many
+  /// vertices, the thorough passes that follow (a fuller placement search, then relaxed shape
+  /// bounds: most of the time of a cage that ends short) are skipped and the result says
+  /// GaveUp. For a caller with a better option than a long tail of rescued collapses (the
+  /// pipeline's wider envelope, CageOptions::MaximumEnvelopeWidenings). 0 = off.
+  int GiveUpAbove = 0;
   /// For comparisons only: turning these off gives plain (unconstrained) QEM, which does not
   /// keep the guarantees. Link condition, flip and needle checks stay on.
   bool EnforceClearance = true;
@@ -53,6 +59,7 @@ struct SimplifyResult
   int VerticesReached = 0;
   bool TargetReached = false;
   bool Cancelled = false;
+  bool GaveUp = false; ///< stopped after the ordinary pass (SimplifyOptions::GiveUpAbove)
   std::string StopReason; ///< why it stopped before the target (empty when reached)
   long long Collapses = 0;
   long long RejectedInput = 0;    ///< candidate collapses vetoed by the input clearance

@@ -333,6 +333,7 @@ TEST(AnyMeshWidening, OffKeepsTheIsovalueOnReportsTheWiderEnvelope)
   EXPECT_FALSE(off.StopReason.empty());
   EXPECT_TRUE(off.WideningLog.empty());
   options.MaximumEnvelopeWidenings = 3;
+  options.ChooseIsoValueFirst = false; // the plain widening: every isovalue built from the requested one
   const CageResult on = generateCage(input, options);
   ASSERT_EQ(on.State, Status::Ok) << on.Message;
   EXPECT_TRUE(on.TargetReached) << on.StopReason;
@@ -340,6 +341,9 @@ TEST(AnyMeshWidening, OffKeepsTheIsovalueOnReportsTheWiderEnvelope)
   EXPECT_EQ(on.IsoValueUsed, options.Envelope.IsoValue * (1 << on.EnvelopeWidenings));
   EXPECT_NE(on.WideningLog.find("isovalue 0.01:"), std::string::npos) << on.WideningLog;
   EXPECT_TRUE(on.EnclosureVerified);
+  EXPECT_EQ(on.EnvelopeProbes, 0);
+  EXPECT_EQ(on.EnvelopeAttempts, on.EnvelopeWidenings + 1);
+  // (the default, probes first, on this input: the AnyMesh case SphereWithDebris)
   // a closed input is never widened, whatever its target
   CageOptions closed;
   closed.TargetNumberOfVertices = 5; // a torus cannot have 5 vertices
@@ -349,6 +353,102 @@ TEST(AnyMeshWidening, OffKeepsTheIsovalueOnReportsTheWiderEnvelope)
   EXPECT_FALSE(torus.TargetReached);
   EXPECT_EQ(torus.EnvelopeWidenings, 0);
   EXPECT_TRUE(torus.WideningLog.empty());
+}
+
+/// 125 small open boxes (two triangles missing each) on a 5 x 5 x 5 lattice, 0.1 apart (about
+/// 0.1 in unit-sphere units too): a soup whose envelope keeps the boxes apart (125 parts: 500
+/// vertices or more) until the isovalue bridges the gaps (0.08).
+PolygonMesh boxLattice()
+{
+  TriangleMesh soup;
+  for (int i = 0; i < 5; ++i)
+    for (int j = 0; j < 5; ++j)
+      for (int k = 0; k < 5; ++k)
+      {
+        const Vec3 lo(0.25 * i, 0.25 * j, 0.25 * k);
+        TriangleMesh box = makeBox(lo, lo + Vec3(0.15, 0.15, 0.15));
+        box.Triangles.resize(10);
+        soup = append(soup, box);
+      }
+  return PolygonMesh::fromTriangles(soup);
+}
+
+TEST(AnyMeshWidening, ProbesSkipTheFineRunsOfEnvelopesThatCannotCarryTheTarget)
+{
+  const PolygonMesh input = boxLattice();
+  CageOptions options;
+  options.TargetNumberOfVertices = 100;
+  options.Envelope.IsoValue = 0.02; // then 0.04 and 0.08 (a quick test: coarser grids)
+  options.MaximumEnvelopeWidenings = 2;
+  options.ChooseIsoValueFirst = false;
+  const CageResult plain = generateCage(input, options);
+  ASSERT_EQ(plain.State, Status::Ok) << plain.Message;
+  ASSERT_TRUE(plain.TargetReached) << plain.StopReason;
+  EXPECT_EQ(plain.EnvelopeProbes, 0);
+  EXPECT_EQ(plain.EnvelopeWidenings, 2) << plain.WideningLog; // 125 parts at 0.02 and 0.04
+  EXPECT_EQ(plain.EnvelopeAttempts, plain.EnvelopeWidenings + 1) << plain.WideningLog;
+
+  options.ChooseIsoValueFirst = true;
+  const CageResult probed = generateCage(input, options);
+  ASSERT_EQ(probed.State, Status::Ok) << probed.Message;
+  EXPECT_TRUE(probed.TargetReached) << probed.StopReason;
+  EXPECT_GE(probed.EnvelopeProbes, 1);
+  EXPECT_GE(probed.IsoValuesSkipped, 1);
+  EXPECT_NE(probed.WideningLog.find("not built"), std::string::npos) << probed.WideningLog;
+  EXPECT_LT(probed.EnvelopeAttempts, plain.EnvelopeAttempts) << probed.WideningLog << "\n" << plain.WideningLog;
+  // the same isovalue as the plain widening, so the same cage (the run at the widest isovalue
+  // is the last one allowed either way)
+  EXPECT_EQ(probed.IsoValueUsed, plain.IsoValueUsed);
+  EXPECT_EQ(probed.EnvelopeWidenings, plain.EnvelopeWidenings);
+  EXPECT_EQ(probed.IsoValueUsed, options.Envelope.IsoValue * (1 << probed.EnvelopeWidenings));
+  ASSERT_EQ(probed.Cage.Points.size(), plain.Cage.Points.size());
+  EXPECT_EQ(probed.Cage.Points, plain.Cage.Points);
+  EXPECT_EQ(static_cast<int>(probed.Cage.Points.size()), options.TargetNumberOfVertices);
+  const exact::ExactReport e = exact::exactCheck(asGiven(input), probed.Cage, 0.0);
+  EXPECT_TRUE(e.Encloses) << exact::toJson(e);
+  EXPECT_EQ(e.InputIntersections, 0);
+  EXPECT_EQ(e.SelfIntersections, 0);
+  EXPECT_EQ(e.InputVerticesOutside, 0);
+
+  // few parts (the target can carry them apart): no probe, the plain path
+  options.TargetNumberOfVertices = 600;
+  options.MaximumEnvelopeWidenings = 1;
+  const CageResult many = generateCage(input, options);
+  EXPECT_EQ(many.EnvelopeProbes, 0) << many.WideningLog;
+}
+
+TEST(AnyMeshWidening, GiveUpStopsTheSimplificationAfterItsOrdinaryPass)
+{
+  EXPECT_EQ(WideningGiveUpAbove(500), 600);
+  EXPECT_EQ(WideningGiveUpAbove(20), 28);
+  // a torus cannot have 4 vertices: the ordinary pass ends above 6
+  const TriangleMesh torus = makeTorus(Vec3(0, 0, 0), 0.7, 0.25, 48, 24);
+  EnvelopeOptions eo;
+  eo.UseActivePoints = false;
+  eo.IsoValue = 0.04; // a small envelope: a quick test
+  const EnvelopeResult env = buildEnvelope(torus, eo);
+  ASSERT_EQ(env.State, Status::Ok) << env.Message;
+  const TriangleTree tree(torus);
+  SimplifyOptions so;
+  so.TargetNumberOfVertices = 4;
+  so.Clearance = eo.clearance();
+  const SimplifyResult full = simplifyEnvelope(env.Envelope, tree, so);
+  so.GiveUpAbove = 6;
+  const SimplifyResult early = simplifyEnvelope(env.Envelope, tree, so);
+  EXPECT_FALSE(full.GaveUp);
+  EXPECT_FALSE(full.TargetReached);
+  EXPECT_TRUE(early.GaveUp);
+  EXPECT_FALSE(early.TargetReached);
+  EXPECT_GT(early.VerticesReached, 6);
+  EXPECT_GE(early.VerticesReached, full.VerticesReached);
+  EXPECT_NE(early.StopReason.find("ordinary pass"), std::string::npos) << early.StopReason;
+  EXPECT_EQ(static_cast<int>(early.Cage.Points.size()), early.VerticesReached);
+  // a generous bound changes nothing
+  so.GiveUpAbove = static_cast<int>(env.Envelope.Points.size());
+  const SimplifyResult same = simplifyEnvelope(env.Envelope, tree, so);
+  EXPECT_FALSE(same.GaveUp);
+  EXPECT_EQ(same.VerticesReached, full.VerticesReached);
+  EXPECT_EQ(same.Cage.Points, full.Cage.Points);
 }
 
 TEST(AnyMeshRepairs, AreCounted)
