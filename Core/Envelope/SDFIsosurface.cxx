@@ -23,6 +23,12 @@
 #include <limits>
 #include <mutex>
 #include <cstdlib>
+#include <condition_variable>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <system_error>
+#include <thread>
 
 namespace sdfcage
 {
@@ -235,17 +241,10 @@ std::size_t amplify(openvdb::FloatGrid& grid, const openvdb::Int32Grid& index, c
   return changed.load();
 }
 
-/// The isosurface {value = iso} of `grid` (unit-sphere units), quads split on the shorter
-/// diagonal, counter-clockwise seen from outside; no adaptivity inside `noAdapt`.
-TriangleMesh extract(
-  const openvdb::FloatGrid& grid, double iso, double adaptivity, const openvdb::BoolTree::Ptr& noAdapt)
+/// OpenVDB's polygons as our triangles (unit-sphere units): quads split on the shorter diagonal,
+/// counter-clockwise seen from outside.
+TriangleMesh toTriangles(const openvdb::tools::VolumeToMesh& mesher)
 {
-  openvdb::tools::VolumeToMesh mesher(iso, adaptivity, true);
-  if (noAdapt && adaptivity > 0.0)
-  {
-    mesher.setAdaptivityMask(noAdapt);
-  }
-  mesher(grid);
   TriangleMesh s;
   s.Points.resize(mesher.pointListSize());
   const auto& pts = mesher.pointList();
@@ -281,6 +280,145 @@ TriangleMesh extract(
     }
   }
   return s;
+}
+
+/// The extractions still running after a cancel (see extract): the process waits for them at its
+/// exit (this object's destructor runs before those of OpenVDB's and TBB's statics, which were
+/// made before it), so that none is inside OpenVDB or TBB while they are torn down.
+class AbandonedExtractions
+{
+public:
+  static AbandonedExtractions& instance()
+  {
+    static AbandonedExtractions registry;
+    return registry;
+  }
+  void started()
+  {
+    std::lock_guard<std::mutex> lock(this->Mutex);
+    ++this->Running;
+  }
+  void ended()
+  {
+    std::lock_guard<std::mutex> lock(this->Mutex);
+    --this->Running;
+    this->Done.notify_all();
+  }
+  ~AbandonedExtractions()
+  {
+    std::unique_lock<std::mutex> lock(this->Mutex);
+    this->Done.wait(lock, [this]() { return this->Running == 0; });
+  }
+
+private:
+  std::mutex Mutex;
+  std::condition_variable Done;
+  int Running = 0;
+};
+
+/// One extraction: OpenVDB's VolumeToMesh (no interrupter in OpenVDB 10), on a thread of its own.
+struct ExtractionJob
+{
+  openvdb::FloatGrid::ConstPtr Grid;
+  openvdb::BoolTree::ConstPtr NoAdapt;
+  double Iso = 0.0;
+  double Adaptivity = 0.0;
+  openvdb::tools::VolumeToMesh Mesher;
+  std::string Error;
+  std::mutex Mutex;
+  std::condition_variable Changed;
+  bool Finished = false;
+
+  ExtractionJob(openvdb::FloatGrid::ConstPtr grid, openvdb::BoolTree::ConstPtr noAdapt, double iso, double adaptivity)
+    : Grid(std::move(grid))
+    , NoAdapt(std::move(noAdapt))
+    , Iso(iso)
+    , Adaptivity(adaptivity)
+    , Mesher(iso, adaptivity, true)
+  {
+    if (this->NoAdapt && adaptivity > 0.0)
+    {
+      this->Mesher.setAdaptivityMask(this->NoAdapt);
+    }
+  }
+  void run()
+  {
+    try
+    {
+      this->Mesher(*this->Grid);
+    }
+    catch (const std::exception& e)
+    {
+      this->Error = e.what();
+    }
+    catch (...)
+    {
+      this->Error = "unknown error";
+    }
+    std::lock_guard<std::mutex> lock(this->Mutex);
+    this->Finished = true;
+    this->Changed.notify_all();
+  }
+};
+
+/// The isosurface {value = iso} of `grid` (unit-sphere units), quads split on the shorter
+/// diagonal, counter-clockwise seen from outside; no adaptivity inside `noAdapt`.
+///
+/// OpenVDB's VolumeToMesh has no interrupter, and one extraction takes 0.4-1.0 s on
+/// armadillo_midsub4x (2 loaded cores). So it runs on a thread of its own while this one checks
+/// `progress` every 20 ms: a cancel returns at once (`cancelled` set, empty mesh) and abandons the
+/// extraction, which ends on its own (it owns what it reads: the grid and the mask are shared) and
+/// frees its memory; the process waits for it at exit (AbandonedExtractions). Same mesh as a plain
+/// call: the same OpenVDB code on the same data. Throws what the extraction threw (as
+/// std::runtime_error).
+TriangleMesh extract(const openvdb::FloatGrid::ConstPtr& grid, double iso, double adaptivity,
+  const openvdb::BoolTree::ConstPtr& noAdapt, Progress* progress, bool& cancelled)
+{
+  cancelled = false;
+  auto job = std::make_shared<ExtractionJob>(grid, noAdapt, iso, adaptivity);
+  if (!progress)
+  {
+    job->run(); // nothing can cancel: no thread
+  }
+  else
+  {
+    AbandonedExtractions& abandoned = AbandonedExtractions::instance();
+    abandoned.started();
+    try
+    {
+      std::thread([job, &abandoned]() mutable {
+        job->run();
+        job.reset(); // frees the mesh of an abandoned extraction before the exit may go on
+        abandoned.ended();
+      }).detach();
+    }
+    catch (const std::system_error&)
+    {
+      abandoned.ended();
+      job->run(); // no thread to be had: uninterruptible, as OpenVDB is
+    }
+    std::unique_lock<std::mutex> lock(job->Mutex);
+    while (!job->Finished)
+    {
+      if (job->Changed.wait_for(lock, std::chrono::milliseconds(20), [&job]() { return job->Finished; }))
+      {
+        break;
+      }
+      lock.unlock();
+      const bool stop = progress->cancelled(); // may fire the filter's progress event: unlocked
+      lock.lock();
+      if (stop && !job->Finished)
+      {
+        cancelled = true;
+        return TriangleMesh();
+      }
+    }
+  }
+  if (!job->Error.empty())
+  {
+    throw std::runtime_error(job->Error);
+  }
+  return toTriangles(job->Mesher);
 }
 
 /// Marks the voxels within `radius` voxels of each point (unit-sphere units).
@@ -699,8 +837,14 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
       const auto te = std::chrono::steady_clock::now();
       try
       {
-        surface = extract(*grid, iso, adaptivity, noAdapt->empty() ? nullptr : noAdapt);
+        bool stopped = false;
+        surface = extract(grid, iso, adaptivity, noAdapt->empty() ? nullptr : noAdapt, progress, stopped);
         extractionSeconds += seconds(te);
+        if (stopped)
+        {
+          out.Cancelled = true;
+          return out;
+        }
       }
       catch (const std::exception& e)
       {
