@@ -38,7 +38,7 @@ namespace
 
 /// OpenVDB interrupter backed by our Progress: one mechanism for both. Past `ExpansionPercent`
 /// (meshToVolume's narrow-band expansion, which checks only between its iterations, each seconds
-/// long on a large mesh) it arms `Expanding`: CancellableMeshAdapter stops the work from inside.
+/// long on a large mesh) it arms `Expanding`: CancellableMeshAdapter cuts the work short from inside.
 class VdbInterrupter : public openvdb::util::NullInterrupter
 {
 public:
@@ -75,17 +75,15 @@ private:
   std::atomic<bool>* Expanding;
 };
 
-/// Thrown by CancellableMeshAdapter: TBB carries it out of OpenVDB's parallel loops, and
-/// meshToVolume's caller catches it. (The expansion's nodes made so far are then not freed:
-/// OpenVDB holds them by raw pointers until the end of an iteration. A few megabytes per cancel.)
-struct VdbStopped
-{
-};
-
 /// The triangles for meshToVolume (as openvdb::tools::QuadAndTriangleDataAdapter gives them),
 /// with a cancel check in the one call every distance computation makes: once `expanding` is set
 /// (OpenVDB's own checks cover the voxelization before it), every 1024th call on a thread checks
-/// `progress` and throws VdbStopped when it is cancelled.
+/// `progress`. From a cancel on, every triangle answers as if it were far away (1e15 index units):
+/// no voxel is within the band any more, so the band expansion's current iteration makes no new
+/// node and skips its second layer, ends, and OpenVDB's check before the next one returns. (It
+/// used to throw instead, which stopped sooner but lost the nodes made so far in the iteration:
+/// OpenVDB holds them by raw pointers in its parallel_reduce bodies until the iteration's end, a
+/// few megabytes per cancel.) The grid is then wrong, and thrown away: the caller sees the cancel.
 class CancellableMeshAdapter
 {
 public:
@@ -105,9 +103,11 @@ public:
     if (P && Expanding->load(std::memory_order_relaxed))
     {
       thread_local unsigned calls = 0;
-      if ((++calls & 1023u) == 0 && P->cancelled())
+      if (Stopped.load(std::memory_order_relaxed) || ((++calls & 1023u) == 0 && P->cancelled()))
       {
-        throw VdbStopped();
+        Stopped.store(true, std::memory_order_relaxed);
+        pos = openvdb::Vec3d(1e15, 1e15, 1e15);
+        return;
       }
     }
     const openvdb::Vec3s& p = Points[Triangles[n][static_cast<int>(v)]];
@@ -121,6 +121,7 @@ private:
   const std::vector<openvdb::Vec3I>& Triangles;
   Progress* P;
   const std::atomic<bool>* Expanding;
+  mutable std::atomic<bool> Stopped{ false };
 };
 
 double seconds(std::chrono::steady_clock::time_point t0)
@@ -594,11 +595,6 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
   {
     grid = openvdb::tools::meshToVolume<openvdb::FloatGrid>(sdfInterrupter, adapter, *transform, exteriorBand,
       interiorBand, unsignedField ? openvdb::tools::UNSIGNED_DISTANCE_FIELD : 0, closestTriangle.get());
-  }
-  catch (const VdbStopped&)
-  {
-    out.Cancelled = true;
-    return out;
   }
   catch (const std::exception& e)
   {
