@@ -676,9 +676,12 @@ private:
 
 /// g_A: the geodesic distance to the nearest active sample, from one search with all of them as
 /// sources, up to the cutoff (points beyond keep it). Returns the number of active samples.
+/// Reports progress in (0.9, 1) and checks for a cancel every 1024 settled points: `cancelled`
+/// is set when it stopped (g then incomplete).
 std::size_t geodesicToActive(const EdgeGraph& graph, const std::vector<int>& samples,
-  const ActiveSampleDetection& detection, double cutoff, std::vector<double>& g)
+  const ActiveSampleDetection& detection, double cutoff, std::vector<double>& g, Progress* progress, bool& cancelled)
 {
+  cancelled = false;
   BoundedDijkstra spread(graph);
   spread.restart();
   std::size_t sources = 0;
@@ -690,8 +693,15 @@ std::size_t geodesicToActive(const EdgeGraph& graph, const std::vector<int>& sam
       ++sources;
     }
   }
+  const double points = static_cast<double>(std::max<std::size_t>(1, g.size()));
+  std::size_t settled = 0;
   spread.run(cutoff, [&](int u, double d) {
     g[u] = d;
+    if ((++settled & 1023u) == 0 && progressUpdate(progress, 0.9 + 0.1 * std::min(0.999, settled / points)))
+    {
+      cancelled = true;
+      return false;
+    }
     return true;
   });
   return sources;
@@ -953,7 +963,15 @@ ActivePoints computeActivePoints(const TriangleMesh& unitInput, const ActivePoin
 
   // g_A, and the points flagged active: those within half a spacing of an active sample (the
   // resolution of the sampling)
-  result.NumberOfActiveSamples = geodesicToActive(graph, samples, detection, result.Cutoff, result.GeodesicToActive);
+  bool stopped = false;
+  result.NumberOfActiveSamples =
+    geodesicToActive(graph, samples, detection, result.Cutoff, result.GeodesicToActive, progress, stopped);
+  if (stopped)
+  {
+    result.Cancelled = true;
+    result.Seconds = seconds(t0);
+    return result;
+  }
   for (std::size_t i = 0; i < n; ++i)
   {
     if (referenced[i] && result.GeodesicToActive[i] <= separation)

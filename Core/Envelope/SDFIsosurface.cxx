@@ -23,6 +23,12 @@
 #include <limits>
 #include <mutex>
 #include <cstdlib>
+#include <condition_variable>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <system_error>
+#include <thread>
 
 namespace sdfcage
 {
@@ -32,7 +38,7 @@ namespace
 
 /// OpenVDB interrupter backed by our Progress: one mechanism for both. Past `ExpansionPercent`
 /// (meshToVolume's narrow-band expansion, which checks only between its iterations, each seconds
-/// long on a large mesh) it arms `Expanding`: CancellableMeshAdapter stops the work from inside.
+/// long on a large mesh) it arms `Expanding`: CancellableMeshAdapter cuts the work short from inside.
 class VdbInterrupter : public openvdb::util::NullInterrupter
 {
 public:
@@ -69,17 +75,15 @@ private:
   std::atomic<bool>* Expanding;
 };
 
-/// Thrown by CancellableMeshAdapter: TBB carries it out of OpenVDB's parallel loops, and
-/// meshToVolume's caller catches it. (The expansion's nodes made so far are then not freed:
-/// OpenVDB holds them by raw pointers until the end of an iteration. A few megabytes per cancel.)
-struct VdbStopped
-{
-};
-
 /// The triangles for meshToVolume (as openvdb::tools::QuadAndTriangleDataAdapter gives them),
 /// with a cancel check in the one call every distance computation makes: once `expanding` is set
 /// (OpenVDB's own checks cover the voxelization before it), every 1024th call on a thread checks
-/// `progress` and throws VdbStopped when it is cancelled.
+/// `progress`. From a cancel on, every triangle answers as if it were far away (1e15 index units):
+/// no voxel is within the band any more, so the band expansion's current iteration makes no new
+/// node and skips its second layer, ends, and OpenVDB's check before the next one returns. (It
+/// used to throw instead, which stopped sooner but lost the nodes made so far in the iteration:
+/// OpenVDB holds them by raw pointers in its parallel_reduce bodies until the iteration's end, a
+/// few megabytes per cancel.) The grid is then wrong, and thrown away: the caller sees the cancel.
 class CancellableMeshAdapter
 {
 public:
@@ -99,9 +103,11 @@ public:
     if (P && Expanding->load(std::memory_order_relaxed))
     {
       thread_local unsigned calls = 0;
-      if ((++calls & 1023u) == 0 && P->cancelled())
+      if (Stopped.load(std::memory_order_relaxed) || ((++calls & 1023u) == 0 && P->cancelled()))
       {
-        throw VdbStopped();
+        Stopped.store(true, std::memory_order_relaxed);
+        pos = openvdb::Vec3d(1e15, 1e15, 1e15);
+        return;
       }
     }
     const openvdb::Vec3s& p = Points[Triangles[n][static_cast<int>(v)]];
@@ -115,6 +121,7 @@ private:
   const std::vector<openvdb::Vec3I>& Triangles;
   Progress* P;
   const std::atomic<bool>* Expanding;
+  mutable std::atomic<bool> Stopped{ false };
 };
 
 double seconds(std::chrono::steady_clock::time_point t0)
@@ -235,17 +242,10 @@ std::size_t amplify(openvdb::FloatGrid& grid, const openvdb::Int32Grid& index, c
   return changed.load();
 }
 
-/// The isosurface {value = iso} of `grid` (unit-sphere units), quads split on the shorter
-/// diagonal, counter-clockwise seen from outside; no adaptivity inside `noAdapt`.
-TriangleMesh extract(
-  const openvdb::FloatGrid& grid, double iso, double adaptivity, const openvdb::BoolTree::Ptr& noAdapt)
+/// OpenVDB's polygons as our triangles (unit-sphere units): quads split on the shorter diagonal,
+/// counter-clockwise seen from outside.
+TriangleMesh toTriangles(const openvdb::tools::VolumeToMesh& mesher)
 {
-  openvdb::tools::VolumeToMesh mesher(iso, adaptivity, true);
-  if (noAdapt && adaptivity > 0.0)
-  {
-    mesher.setAdaptivityMask(noAdapt);
-  }
-  mesher(grid);
   TriangleMesh s;
   s.Points.resize(mesher.pointListSize());
   const auto& pts = mesher.pointList();
@@ -281,6 +281,145 @@ TriangleMesh extract(
     }
   }
   return s;
+}
+
+/// The extractions still running after a cancel (see extract): the process waits for them at its
+/// exit (this object's destructor runs before those of OpenVDB's and TBB's statics, which were
+/// made before it), so that none is inside OpenVDB or TBB while they are torn down.
+class AbandonedExtractions
+{
+public:
+  static AbandonedExtractions& instance()
+  {
+    static AbandonedExtractions registry;
+    return registry;
+  }
+  void started()
+  {
+    std::lock_guard<std::mutex> lock(this->Mutex);
+    ++this->Running;
+  }
+  void ended()
+  {
+    std::lock_guard<std::mutex> lock(this->Mutex);
+    --this->Running;
+    this->Done.notify_all();
+  }
+  ~AbandonedExtractions()
+  {
+    std::unique_lock<std::mutex> lock(this->Mutex);
+    this->Done.wait(lock, [this]() { return this->Running == 0; });
+  }
+
+private:
+  std::mutex Mutex;
+  std::condition_variable Done;
+  int Running = 0;
+};
+
+/// One extraction: OpenVDB's VolumeToMesh (no interrupter in OpenVDB 10), on a thread of its own.
+struct ExtractionJob
+{
+  openvdb::FloatGrid::ConstPtr Grid;
+  openvdb::BoolTree::ConstPtr NoAdapt;
+  double Iso = 0.0;
+  double Adaptivity = 0.0;
+  openvdb::tools::VolumeToMesh Mesher;
+  std::string Error;
+  std::mutex Mutex;
+  std::condition_variable Changed;
+  bool Finished = false;
+
+  ExtractionJob(openvdb::FloatGrid::ConstPtr grid, openvdb::BoolTree::ConstPtr noAdapt, double iso, double adaptivity)
+    : Grid(std::move(grid))
+    , NoAdapt(std::move(noAdapt))
+    , Iso(iso)
+    , Adaptivity(adaptivity)
+    , Mesher(iso, adaptivity, true)
+  {
+    if (this->NoAdapt && adaptivity > 0.0)
+    {
+      this->Mesher.setAdaptivityMask(this->NoAdapt);
+    }
+  }
+  void run()
+  {
+    try
+    {
+      this->Mesher(*this->Grid);
+    }
+    catch (const std::exception& e)
+    {
+      this->Error = e.what();
+    }
+    catch (...)
+    {
+      this->Error = "unknown error";
+    }
+    std::lock_guard<std::mutex> lock(this->Mutex);
+    this->Finished = true;
+    this->Changed.notify_all();
+  }
+};
+
+/// The isosurface {value = iso} of `grid` (unit-sphere units), quads split on the shorter
+/// diagonal, counter-clockwise seen from outside; no adaptivity inside `noAdapt`.
+///
+/// OpenVDB's VolumeToMesh has no interrupter, and one extraction takes 0.4-1.0 s on
+/// armadillo_midsub4x (2 loaded cores). So it runs on a thread of its own while this one checks
+/// `progress` every 20 ms: a cancel returns at once (`cancelled` set, empty mesh) and abandons the
+/// extraction, which ends on its own (it owns what it reads: the grid and the mask are shared) and
+/// frees its memory; the process waits for it at exit (AbandonedExtractions). Same mesh as a plain
+/// call: the same OpenVDB code on the same data. Throws what the extraction threw (as
+/// std::runtime_error).
+TriangleMesh extract(const openvdb::FloatGrid::ConstPtr& grid, double iso, double adaptivity,
+  const openvdb::BoolTree::ConstPtr& noAdapt, Progress* progress, bool& cancelled)
+{
+  cancelled = false;
+  auto job = std::make_shared<ExtractionJob>(grid, noAdapt, iso, adaptivity);
+  if (!progress)
+  {
+    job->run(); // nothing can cancel: no thread
+  }
+  else
+  {
+    AbandonedExtractions& abandoned = AbandonedExtractions::instance();
+    abandoned.started();
+    try
+    {
+      std::thread([job, &abandoned]() mutable {
+        job->run();
+        job.reset(); // frees the mesh of an abandoned extraction before the exit may go on
+        abandoned.ended();
+      }).detach();
+    }
+    catch (const std::system_error&)
+    {
+      abandoned.ended();
+      job->run(); // no thread to be had: uninterruptible, as OpenVDB is
+    }
+    std::unique_lock<std::mutex> lock(job->Mutex);
+    while (!job->Finished)
+    {
+      if (job->Changed.wait_for(lock, std::chrono::milliseconds(20), [&job]() { return job->Finished; }))
+      {
+        break;
+      }
+      lock.unlock();
+      const bool stop = progress->cancelled(); // may fire the filter's progress event: unlocked
+      lock.lock();
+      if (stop && !job->Finished)
+      {
+        cancelled = true;
+        return TriangleMesh();
+      }
+    }
+  }
+  if (!job->Error.empty())
+  {
+    throw std::runtime_error(job->Error);
+  }
+  return toTriangles(job->Mesher);
 }
 
 /// Marks the voxels within `radius` voxels of each point (unit-sphere units).
@@ -456,11 +595,6 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
   {
     grid = openvdb::tools::meshToVolume<openvdb::FloatGrid>(sdfInterrupter, adapter, *transform, exteriorBand,
       interiorBand, unsignedField ? openvdb::tools::UNSIGNED_DISTANCE_FIELD : 0, closestTriangle.get());
-  }
-  catch (const VdbStopped&)
-  {
-    out.Cancelled = true;
-    return out;
   }
   catch (const std::exception& e)
   {
@@ -699,8 +833,14 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
       const auto te = std::chrono::steady_clock::now();
       try
       {
-        surface = extract(*grid, iso, adaptivity, noAdapt->empty() ? nullptr : noAdapt);
+        bool stopped = false;
+        surface = extract(grid, iso, adaptivity, noAdapt->empty() ? nullptr : noAdapt, progress, stopped);
         extractionSeconds += seconds(te);
+        if (stopped)
+        {
+          out.Cancelled = true;
+          return out;
+        }
       }
       catch (const std::exception& e)
       {
