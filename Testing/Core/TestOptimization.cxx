@@ -284,17 +284,28 @@ TEST(Optimization, RejectsCagesThatDoNotEnclose)
   EXPECT_NE(c.Message.find("closer than the clearance"), std::string::npos) << c.Message;
 }
 
+namespace
+{
+// Numbers in [0, 1) from a fixed seed (a linear congruential generator): the same random queries
+// on every machine for the brute-force comparisons below.
+struct UnitRandom
+{
+  unsigned Seed;
+  double operator()()
+  {
+    Seed = Seed * 1664525u + 1013904223u;
+    return (Seed >> 8) / double(1u << 24);
+  }
+};
+} // namespace
+
 TEST(Optimization, TreeTriangleQueriesMatchBruteForce)
 {
   // the tree's pruning (bounding boxes, the query's plane and side planes) must not change the
   // answers: distances, "any closer" and "all within" against a brute-force loop
   const TriangleMesh mesh = makeTorus(Vec3(0, 0, 0), 1.0, 0.3, 48, 16);
   const TriangleTree tree(mesh);
-  unsigned seed = 12345;
-  auto uniform = [&]() {
-    seed = seed * 1664525u + 1013904223u;
-    return (seed >> 8) / double(1u << 24);
-  };
+  UnitRandom uniform{ 12345u };
   int within = 0;
   for (int trial = 0; trial < 300; ++trial)
   {
@@ -333,11 +344,7 @@ TEST(Optimization, TreeClosestPointMatchesBruteForce)
   // anything lies within the bound, against a brute-force loop
   const TriangleMesh mesh = makeTorus(Vec3(0, 0, 0), 1.0, 0.3, 48, 16);
   const TriangleTree tree(mesh);
-  unsigned seed = 4242;
-  auto uniform = [&]() {
-    seed = seed * 1664525u + 1013904223u;
-    return (seed >> 8) / double(1u << 24);
-  };
+  UnitRandom uniform{ 4242u };
   int inside = 0, outside = 0;
   for (int trial = 0; trial < 500; ++trial)
   {
