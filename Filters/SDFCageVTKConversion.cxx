@@ -12,6 +12,8 @@
 #include "vtkPolyData.h"
 #include "vtkSmartPointer.h"
 #include "vtkStringArray.h"
+#include "vtkTypeInt32Array.h"
+#include "vtkTypeInt64Array.h"
 
 #include <algorithm>
 
@@ -34,10 +36,55 @@ enum class CellKind
   Strip
 };
 
+// Whether the offsets of `cells` describe its connectivity: they start at 0, never decrease and
+// end at the connectivity's size. VTK's cell iterators trust them, and a reader given a damaged
+// file (a fuzzed .vtp or version-5 .vtk, or a filter's bad output) can produce arrays that break
+// this, which would make the iteration read outside the connectivity.
+template <typename Offsets>
+bool OffsetsAreSound(const Offsets* offsets, vtkIdType numberOfOffsets, vtkIdType numberOfIds)
+{
+  if (numberOfOffsets == 0)
+  {
+    return numberOfIds == 0;
+  }
+  if (offsets[0] != 0 || static_cast<vtkIdType>(offsets[numberOfOffsets - 1]) != numberOfIds)
+  {
+    return false;
+  }
+  for (vtkIdType i = 1; i < numberOfOffsets; ++i)
+  {
+    if (offsets[i] < offsets[i - 1])
+    {
+      return false;
+    }
+  }
+  return true;
+}
+
+bool CellArrayIsSound(vtkCellArray* cells)
+{
+  const vtkIdType numberOfIds = cells->GetNumberOfConnectivityIds();
+  if (cells->IsStorage64Bit())
+  {
+    vtkTypeInt64Array* offsets = cells->GetOffsetsArray64();
+    return OffsetsAreSound(offsets->GetPointer(0), offsets->GetNumberOfValues(), numberOfIds);
+  }
+  vtkTypeInt32Array* offsets = cells->GetOffsetsArray32();
+  return OffsetsAreSound(offsets->GetPointer(0), offsets->GetNumberOfValues(), numberOfIds);
+}
+
 void AppendCells(vtkCellArray* cells, CellKind kind, sdfcage::PolygonMesh& mesh)
 {
   if (!cells || cells->GetNumberOfCells() == 0)
   {
+    return;
+  }
+  if (!CellArrayIsSound(cells))
+  {
+    // Nothing in a damaged cell array can be trusted: one cell naming a point that does not
+    // exist, so that Core refuses the input as invalid ("... refer to points that do not exist")
+    // instead of caging a guess.
+    mesh.addCell({ -1, -1, -1 });
     return;
   }
   auto it = vtk::TakeSmartPointer(cells->NewIterator());

@@ -27,6 +27,8 @@
 #include <algorithm>
 #include <cctype>
 #include <cerrno>
+#include <cstdint>
+#include <cstdlib>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -106,6 +108,83 @@ vtkSmartPointer<vtkPolyData> toPolyData(const ParsedMesh& ply)
   return mesh;
 }
 
+/// Legacy VTK cell lists before file version 5 ("POLYGONS n size" followed by `size` values,
+/// each cell its point count and then its points): vtkPolyDataReader reads the `size` values and
+/// then walks them cell by cell trusting every count, so a count larger than what is left of the
+/// section made it read past its buffer (a fuzzed file crashed it). Walk the section here first:
+/// every cell must fit in it. `start` is where the values begin (the line after the header);
+/// sections VTK cannot read at all (too short, not numbers) are left for VTK to refuse. Files of
+/// version 5 and later (an OFFSETS line follows) are checked after reading (checkCellArrays).
+bool checkLegacyCells(const std::string& bytes, std::size_t start, bool binary, double declaredValues,
+  const std::string& keyword, int lineNumber, std::string& why)
+{
+  std::size_t first = bytes.find_first_not_of(" \t\r\n", start);
+  if (first != std::string::npos && bytes.compare(first, 7, "OFFSETS") == 0)
+  {
+    return true;
+  }
+  const auto values = static_cast<std::size_t>(declaredValues); // fits: checked against the file size
+  auto refuse = [&](std::size_t cell, long long points, std::size_t at) {
+    std::ostringstream m;
+    m << "line " << lineNumber << ": " << keyword << " cell " << cell + 1 << " lists " << points
+      << " points, but only " << (values - at - 1) << " of the section's " << values
+      << " values are left for them (the file is damaged)";
+    why = m.str();
+    return false;
+  };
+  std::size_t cell = 0;
+  std::size_t at = 0; // index of the value being read
+  if (binary)
+  {
+    // big-endian 32-bit integers, right after the header line
+    if (start > bytes.size() || bytes.size() - start < 4 * values)
+    {
+      return true; // VTK refuses a short section itself
+    }
+    const auto* b = reinterpret_cast<const unsigned char*>(bytes.data() + start);
+    while (at < values)
+    {
+      const std::int32_t count = static_cast<std::int32_t>((std::uint32_t(b[4 * at]) << 24) |
+        (std::uint32_t(b[4 * at + 1]) << 16) | (std::uint32_t(b[4 * at + 2]) << 8) | std::uint32_t(b[4 * at + 3]));
+      if (count < 0 || static_cast<std::size_t>(count) > values - at - 1)
+      {
+        return refuse(cell, count, at);
+      }
+      at += 1 + static_cast<std::size_t>(count);
+      ++cell;
+    }
+    return true;
+  }
+  const char* cursor = bytes.c_str() + std::min(start, bytes.size());
+  std::size_t skip = 0; // values of the current cell still to pass over
+  while (at < values)
+  {
+    char* end = nullptr;
+    errno = 0;
+    const long long v = std::strtoll(cursor, &end, 10);
+    if (end == cursor || errno != 0)
+    {
+      return true; // not a number: VTK refuses the section itself
+    }
+    cursor = end;
+    if (skip > 0)
+    {
+      --skip;
+    }
+    else
+    {
+      if (v < 0 || static_cast<unsigned long long>(v) > values - at - 1)
+      {
+        return refuse(cell, v, at);
+      }
+      skip = static_cast<std::size_t>(v);
+      ++cell;
+    }
+    ++at;
+  }
+  return true;
+}
+
 /// Legacy VTK files: every count a section header declares (POINTS n, POLYGONS n size, ...,
 /// POINT_DATA n, field arrays "name components tuples type") must fit in the file (at least
 /// two bytes a value in ASCII, one in binary) before vtkPolyDataReader allocates for it: a
@@ -175,6 +254,10 @@ bool checkLegacyCounts(const std::string& bytes, std::string& why)
       }
       if (tooLarge(std::max(n, values), count(n) + " cells of " +
               count(values) + " values"))
+      {
+        return false;
+      }
+      if (!checkLegacyCells(bytes, pos, binary, values, keyword, lineNumber, why))
       {
         return false;
       }

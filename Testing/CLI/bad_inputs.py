@@ -81,6 +81,32 @@ def vtk_text(points, faces, npoints=None, header_polys=None):
     return text.encode()
 
 
+def vtk_binary(points, faces, first_count=None):
+    """A legacy binary POLYDATA file (big-endian); `first_count` replaces the first cell's count."""
+    data = b"# vtk DataFile Version 3.0\nbad_inputs.py\nBINARY\nDATASET POLYDATA\n"
+    data += b"POINTS %d float\n" % len(points) + b"".join(struct.pack(">3f", *p) for p in points) + b"\n"
+    values = [v for f in faces for v in (len(f),) + tuple(f)]
+    if first_count is not None:
+        values[0] = first_count
+    data += b"POLYGONS %d %d\n" % (len(faces), len(values)) + struct.pack(">%di" % len(values), *values) + b"\n"
+    return data
+
+
+def vtk5_text(points, faces, bad_offset=None):
+    """A version-5.1 legacy file (OFFSETS / CONNECTIVITY); `bad_offset` replaces the second offset."""
+    offsets = [0]
+    for f in faces:
+        offsets.append(offsets[-1] + len(f))
+    if bad_offset is not None:
+        offsets[1] = bad_offset
+    text = "# vtk DataFile Version 5.1\nbad_inputs.py\nASCII\nDATASET POLYDATA\n"
+    text += f"POINTS {len(points)} float\n" + "".join(" ".join(str(c) for c in p) + "\n" for p in points)
+    text += f"POLYGONS {len(offsets)} {offsets[-1] if bad_offset is None else sum(len(f) for f in faces)}\n"
+    text += "OFFSETS vtktypeint64\n" + " ".join(map(str, offsets)) + "\n"
+    text += "CONNECTIVITY vtktypeint64\n" + " ".join(str(i) for f in faces for i in f) + "\n"
+    return text.encode()
+
+
 def obj_text(points, faces):
     text = "".join("v %r %r %r\n" % tuple(float(c) for c in p) for p in points)
     text += "".join("f " + " ".join(str(i) for i in f) + "\n" for f in faces)
@@ -172,6 +198,15 @@ CASES = {
                                "do not exist", {}),
     "index_negative_vtk": ("m.vtk", vtk_text(CUBE_POINTS, CUBE_TRIANGLES[:-1] + [(3, -1, 7)]), [], 2,
                            "do not exist", {}),
+    # a cell whose point count runs past its section (vtkPolyDataReader trusted it and read past
+    # its buffer: a fuzzed file crashed it), in ASCII and binary legacy files
+    "cell_past_section_vtk": ("m.vtk", vtk_text(CUBE_POINTS, CUBE_TRIANGLES, header_polys="POLYGONS 12 3"), [], 2,
+                              "lists 3 points", {}),
+    "cell_past_section_vtk_binary": ("m.vtk", vtk_binary(CUBE_POINTS, CUBE_TRIANGLES, first_count=900), [], 2,
+                                     "lists 900 points", {}),
+    # a version-5 legacy file whose offsets point outside the connectivity
+    "offsets_damaged_vtk5": ("m.vtk", vtk5_text(CUBE_POINTS, CUBE_TRIANGLES, bad_offset=900), [], 2,
+                             "do not exist", {}),
     # OBJ's relative (negative) indices are valid OBJ: a tetrahedron, caged
     "relative_indices_obj": ("m.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
                              b"f -1 -2 -3\nf -4 -3 -2\nf -4 -2 -1\nf -4 -1 -3\n", ["-n", "20"], 0, None,
