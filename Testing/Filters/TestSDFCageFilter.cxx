@@ -467,6 +467,46 @@ int TestNoSurface(const Context&)
   c.Check(IsEmpty(filter->GetOutput(0)), "empty cage");
   c.Check(FieldString(filter->GetOutput(0), "Status") == "InvalidInput", "field data Status InvalidInput");
   CheckResultsTable(c, filter);
+
+  // A cell array whose offsets do not fit its connectivity (a damaged file read by a reader that
+  // does not check them): refused as corrupt, never iterated past the connectivity's end.
+  vtkNew<vtkPoints> tetPoints;
+  tetPoints->InsertNextPoint(0, 0, 0);
+  tetPoints->InsertNextPoint(1, 0, 0);
+  tetPoints->InsertNextPoint(0, 1, 0);
+  tetPoints->InsertNextPoint(0, 0, 1);
+  vtkNew<vtkIdTypeArray> offsets;
+  for (vtkIdType o : { 0, 3, 900, 9, 12 })
+  {
+    offsets->InsertNextValue(o);
+  }
+  vtkNew<vtkIdTypeArray> connectivity;
+  for (vtkIdType id : { 0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3 })
+  {
+    connectivity->InsertNextValue(id);
+  }
+  vtkNew<vtkCellArray> damaged;
+  damaged->SetData(offsets, connectivity);
+  vtkNew<vtkPolyData> tetrahedron;
+  tetrahedron->SetPoints(tetPoints);
+  tetrahedron->SetPolys(damaged);
+  messages->Errors.clear();
+  filter->SetInputData(tetrahedron);
+  filter->Update();
+  std::cout << "  error: " << (messages->Errors.empty() ? "(none)" : messages->Errors[0]) << "\n";
+  c.Check(messages->ErrorContains("do not exist"), "damaged offsets are refused as a corrupt input");
+  c.Check(IsEmpty(filter->GetOutput(0)), "empty cage for damaged offsets");
+  c.Check(std::string(filter->GetStatusString()) == "InvalidInput", "status InvalidInput for damaged offsets");
+
+  // The same tetrahedron with sound offsets is caged (the check refuses only what is damaged).
+  offsets->SetValue(2, 6);
+  offsets->Modified();
+  tetrahedron->Modified();
+  messages->Errors.clear();
+  filter->SetTargetNumberOfVertices(20);
+  filter->Update();
+  c.Check(messages->Errors.empty(), "sound offsets: no error");
+  c.Check(filter->GetOutput(0)->GetNumberOfPoints() == 20, "sound offsets: a 20-vertex cage");
   return c.Result();
 }
 
