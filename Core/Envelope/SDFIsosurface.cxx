@@ -305,6 +305,8 @@ public:
     --this->Running;
     this->Done.notify_all();
   }
+  void abandoned() { this->Count.fetch_add(1); }
+  long long count() const { return this->Count.load(); }
   ~AbandonedExtractions()
   {
     std::unique_lock<std::mutex> lock(this->Mutex);
@@ -315,6 +317,7 @@ private:
   std::mutex Mutex;
   std::condition_variable Done;
   int Running = 0;
+  std::atomic<long long> Count{ 0 }; // abandoned since the process started
 };
 
 /// One extraction: OpenVDB's VolumeToMesh (no interrupter in OpenVDB 10), on a thread of its own.
@@ -411,6 +414,7 @@ TriangleMesh extract(const openvdb::FloatGrid::ConstPtr& grid, double iso, doubl
       if (stop && !job->Finished)
       {
         cancelled = true;
+        AbandonedExtractions::instance().abandoned();
         return TriangleMesh();
       }
     }
@@ -440,6 +444,11 @@ void markAround(const std::vector<Vec3>& points, double voxelSize, int radius, o
 }
 
 } // namespace
+
+long long abandonedExtractionCount()
+{
+  return AbandonedExtractions::instance().count();
+}
 
 bool computeDisplayFields(const TriangleMesh& unitMesh, double iso, double minSpacing,
   const ActivePoints* amplification, ScalarImage& field, ScalarImage* modified, std::string& error)
@@ -821,6 +830,7 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
     return out;
   }
 
+  progressUpdate(progress, 0.6); // the field is done, the surface part begins
   // the extractions and the display field only: the judge's time is its caller's to count
   double extractionSeconds = 0.0;
   for (std::size_t k = 0; k < adaptivities.size(); ++k)

@@ -62,6 +62,11 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
   const SurfaceJudge* judge = nullptr, int maxRepairs = 3, SignMode sign = SignMode::FloodFill,
   const TriangleTree* windingTree = nullptr);
 
+/// How many isosurface extractions a cancel has abandoned since the process started (each ends
+/// on its own thread and frees its memory; the process waits for them at exit). For tests and
+/// diagnostics: it tells a cancel answered from inside an extraction from one answered after it.
+long long abandonedExtractionCount();
+
 /// For display: xi sampled on a regular grid over the mesh's box plus a margin (spacing at least
 /// `minSpacing`, at most ~256 samples per axis), interior filled, exterior band wide enough to
 /// show the amplification. With `amplification` (non-empty) and `modified`, also phi * xi on the

@@ -5,6 +5,7 @@
 #include "Common/GracePeriod.h"
 #include "Common/Progress.h"
 #include "Envelope/ActivePoints.h"
+#include "Envelope/SDFIsosurface.h"
 #include "ExactCheck.h"
 #include "Mesh/Mesh.h"
 #include "Mesh/Normalization.h"
@@ -368,4 +369,70 @@ TEST(CancelDistanceField, InsideOpenVDBsBandExpansion)
     EXPECT_TRUE(r.Cage.empty());
     EXPECT_TRUE(r.Envelope.empty());
   }
+}
+
+namespace
+{
+/// Cancels at the first poll that comes `Wait` after the stage's progress first reached `From`
+/// (and stayed there: nothing reports progress while OpenVDB's VolumeToMesh runs, so the polls
+/// after that point come from the wait on the extraction's thread).
+class CancelWhileWaiting : public Progress
+{
+public:
+  CancelWhileWaiting(double from, std::chrono::milliseconds wait)
+    : From(from)
+    , Wait(wait)
+  {
+  }
+
+protected:
+  bool pollCancel() override
+  {
+    if (this->overall() < this->From)
+    {
+      return false;
+    }
+    const auto now = std::chrono::steady_clock::now();
+    if (!this->Reached)
+    {
+      this->Reached = true;
+      this->ReachedAt = now;
+      return false;
+    }
+    return now - this->ReachedAt >= this->Wait;
+  }
+
+private:
+  double From;
+  std::chrono::milliseconds Wait;
+  bool Reached = false;
+  std::chrono::steady_clock::time_point ReachedAt;
+};
+} // namespace
+
+TEST(CancelIsosurface, AbandonsARunningExtraction)
+{
+  // computeIsosurface reports 0..0.6 for the distance field, then extracts (OpenVDB's
+  // VolumeToMesh, no interrupter) on a thread of its own while this thread polls every 20 ms.
+  // A cancel 50 ms into the extraction of a fine sphere (hundreds of thousands of quads, well
+  // over 50 ms) must come back cancelled with no surface, the extraction abandoned (counted), not
+  // waited for.
+  const TriangleMesh sphere = makeSphere(Vec3(0.0, 0.0, 0.0), 0.8, 160, 80);
+  const long long before = abandonedExtractionCount();
+  CancelWhileWaiting progress(0.6, std::chrono::milliseconds(50));
+  progress.beginStage("isosurface", 0.0, 1.0);
+  const IsosurfaceOutput out = computeIsosurface(sphere, 0.006, 0.02, false, &progress);
+  EXPECT_TRUE(out.Cancelled) << out.Error;
+  EXPECT_TRUE(out.Surfaces.empty());
+  EXPECT_EQ(abandonedExtractionCount(), before + 1);
+
+  // Without a cancel the same call extracts the whole surface (the abandoned extraction above,
+  // still ending on its own thread, shares nothing with this one).
+  Progress plain;
+  plain.beginStage("isosurface", 0.0, 1.0);
+  const IsosurfaceOutput full = computeIsosurface(sphere, 0.006, 0.02, false, &plain);
+  ASSERT_FALSE(full.Cancelled);
+  ASSERT_EQ(full.Surfaces.size(), 1u);
+  EXPECT_GT(full.Surfaces[0].numberOfTriangles(), 100000u);
+  EXPECT_EQ(abandonedExtractionCount(), before + 1);
 }
