@@ -8,6 +8,7 @@
 
 #include <vtkCallbackCommand.h>
 #include <vtkCellArray.h>
+#include <vtkDataArraySelection.h>
 #include <vtkIdTypeArray.h>
 #include <vtkNew.h>
 #include <vtkOBJWriter.h>
@@ -108,6 +109,52 @@ vtkSmartPointer<vtkPolyData> toPolyData(const ParsedMesh& ply)
   return mesh;
 }
 
+/// VTK XML PolyData: the arrays that are read (the points and the cell arrays; the data arrays
+/// are not read, see readMesh) must declare the components they have: 3 for points, 1 for cell
+/// connectivity and offsets. vtkXMLPolyDataReader allocates components x points before it reads
+/// (a Points array declaring 1e9 components on 4 points allocated 8 GB and ran for minutes).
+/// Only the XML before the appended data (binary) is scanned.
+bool checkXMLComponents(const std::string& bytes, std::string& why)
+{
+  const std::size_t xmlEnd = std::min(bytes.find("<AppendedData"), bytes.size());
+  struct Section
+  {
+    const char* Open;
+    const char* Close;
+    double Components;
+  };
+  const Section sections[] = { { "<Points", "</Points>", 3 }, { "<Verts", "</Verts>", 1 },
+    { "<Lines", "</Lines>", 1 }, { "<Strips", "</Strips>", 1 }, { "<Polys", "</Polys>", 1 } };
+  const std::string attribute = "NumberOfComponents=";
+  for (const Section& section : sections)
+  {
+    std::size_t open = bytes.find(section.Open);
+    while (open < xmlEnd)
+    {
+      const std::size_t close = std::min(bytes.find(section.Close, open), xmlEnd);
+      for (std::size_t a = bytes.find(attribute, open); a < close; a = bytes.find(attribute, a + 1))
+      {
+        std::size_t v = a + attribute.size();
+        if (v < bytes.size() && (bytes[v] == '"' || bytes[v] == '\''))
+        {
+          ++v;
+        }
+        const double components = std::strtod(bytes.c_str() + v, nullptr);
+        if (components != section.Components)
+        {
+          std::ostringstream m;
+          m << "an array of " << (section.Open + 1) << " declares " << bytes.substr(v, std::min<std::size_t>(20, bytes.find_first_of("\"'", v) - v))
+            << " components, it must have " << section.Components;
+          why = m.str();
+          return false;
+        }
+      }
+      open = bytes.find(section.Open, close);
+    }
+  }
+  return true;
+}
+
 /// Legacy VTK cell lists before file version 5 ("POLYGONS n size" followed by `size` values,
 /// each cell its point count and then its points): vtkPolyDataReader reads the `size` values and
 /// then walks them cell by cell trusting every count, so a count larger than what is left of the
@@ -195,6 +242,7 @@ bool checkLegacyCounts(const std::string& bytes, std::string& why)
   bool binary = false;
   std::size_t pos = 0;
   int lineNumber = 0;
+  double tuples = 0; // of the current POINT_DATA / CELL_DATA section
   while (pos < bytes.size())
   {
     std::size_t end = bytes.find('\n', pos);
@@ -240,6 +288,51 @@ bool checkLegacyCounts(const std::string& bytes, std::string& why)
       }
       if (tooLarge(keyword == "POINTS" ? 3 * n : n, count(n) + " " +
               (keyword == "POINTS" ? "points" : "data tuples")))
+      {
+        return false;
+      }
+      if (keyword != "POINTS")
+      {
+        tuples = n;
+      }
+    }
+    else if (keyword == "SCALARS" || keyword == "COLOR_SCALARS" || keyword == "LOOKUP_TABLE")
+    {
+      // values per tuple (SCALARS name type [components], COLOR_SCALARS name components) times
+      // the tuples of the data section, or a lookup table's 4 values per entry (LOOKUP_TABLE
+      // name size): VTK allocates for them before reading (SCALARS with 1e8 components on 4
+      // points allocated 7 GB)
+      std::string name, type;
+      double components = 1;
+      double values = -1;
+      if (keyword == "SCALARS")
+      {
+        if ((in >> name >> type) && (in >> components))
+        {
+          values = components * tuples;
+        }
+        else
+        {
+          values = tuples;
+        }
+      }
+      else if (keyword == "COLOR_SCALARS")
+      {
+        if (in >> name >> components)
+        {
+          values = components * tuples;
+        }
+      }
+      else if ((in >> name >> components))
+      {
+        values = 4 * components; // LOOKUP_TABLE name size ("LOOKUP_TABLE default" has none)
+      }
+      if (components < 0)
+      {
+        why = "line " + std::to_string(lineNumber) + ": " + keyword + " needs a non-negative count";
+        return false;
+      }
+      if (values >= 0 && tooLarge(values, keyword + " " + name + " of " + count(values) + " values"))
       {
         return false;
       }
@@ -441,7 +534,27 @@ vtkSmartPointer<vtkPolyData> readMesh(
       error = "cannot read '" + path + "': not a VTK XML PolyData (.vtp) file";
       return nullptr;
     }
+    {
+      std::string bytes;
+      std::string why;
+      if (!slurp(path, bytes))
+      {
+        error = "cannot read '" + path + "': read error";
+        return nullptr;
+      }
+      if (!checkXMLComponents(bytes, why))
+      {
+        error = "cannot read '" + path + "': " + why;
+        return nullptr;
+      }
+    }
     reader->SetFileName(path.c_str());
+    // Only the points and cells make the cage: the point and cell data arrays are not read.
+    // Their sizes are not checked by the reader before it allocates (a PointData array declaring
+    // 1e9 components on 4 points allocated 8 GB and ran for minutes).
+    reader->UpdateInformation();
+    reader->GetPointDataArraySelection()->DisableAllArrays();
+    reader->GetCellDataArraySelection()->DisableAllArrays();
     run(reader);
   }
   else // ".vtk"

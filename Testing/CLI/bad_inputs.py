@@ -139,6 +139,19 @@ def vtp_billion():
             b'</PolyData></VTKFile>\n')
 
 
+def vtp_tetrahedron(point_components=3, data_components=1):
+    """A tetrahedron as ASCII VTK XML PolyData with a point data array; the components the
+    Points array and the data array declare can lie."""
+    return (b'<?xml version="1.0"?>\n<VTKFile type="PolyData" version="0.1" byte_order="LittleEndian">'
+            b'<PolyData><Piece NumberOfPoints="4" NumberOfPolys="4"><PointData>'
+            b'<DataArray type="Float32" Name="s" NumberOfComponents="%d" format="ascii">0 1 2 3</DataArray>'
+            b'</PointData><Points><DataArray type="Float32" NumberOfComponents="%d" format="ascii">'
+            b'0 0 0 1 0 0 0 1 0 0 0 1</DataArray></Points><Polys>'
+            b'<DataArray type="Int32" Name="connectivity" format="ascii">0 2 1 0 1 3 0 3 2 1 2 3</DataArray>'
+            b'<DataArray type="Int32" Name="offsets" format="ascii">3 6 9 12</DataArray></Polys></Piece>'
+            b'</PolyData></VTKFile>\n') % (data_components, point_components)
+
+
 def random_bytes(n, seed):
     rng = random.Random(seed)
     return bytes(rng.randrange(256) for _ in range(n))
@@ -204,6 +217,24 @@ CASES = {
                               "lists 3 points", {}),
     "cell_past_section_vtk_binary": ("m.vtk", vtk_binary(CUBE_POINTS, CUBE_TRIANGLES, first_count=900), [], 2,
                                      "lists 900 points", {}),
+    # point data whose values per tuple lie (SCALARS with 1e8 components on 8 points allocated
+    # 7 GB, COLOR_SCALARS with 1e9 ran past 17 GB), and a lookup table of a billion entries
+    "scalar_components_vtk": ("m.vtk", vtk_text(CUBE_POINTS, CUBE_TRIANGLES)
+                              + b"POINT_DATA 8\nSCALARS s float 100000000\nLOOKUP_TABLE default\n0 1 2 3 4 5 6 7\n",
+                              [], 2, "SCALARS s of 800000000 values", {}),
+    "color_scalars_vtk": ("m.vtk", vtk_text(CUBE_POINTS, CUBE_TRIANGLES)
+                          + b"POINT_DATA 8\nCOLOR_SCALARS c 1000000000\n0 1 2 3 4 5 6 7\n",
+                          [], 2, "COLOR_SCALARS c of", {}),
+    "lookup_table_vtk": ("m.vtk", vtk_text(CUBE_POINTS, CUBE_TRIANGLES)
+                         + b"POINT_DATA 8\nSCALARS s float 1\nLOOKUP_TABLE t\n0 1 2 3 4 5 6 7\n"
+                         + b"LOOKUP_TABLE t 1000000000\n0 0 0 1\n", [], 2, "LOOKUP_TABLE t of", {}),
+    # a .vtp whose Points array declares a billion components (the reader allocated 8 GB first):
+    # refused; a point data array that does the same is not read at all (only points and cells
+    # make the cage): caged
+    "vtp_point_components": ("m.vtp", vtp_tetrahedron(point_components=1000000000), [], 2,
+                             "declares 1000000000 components", {}),
+    "vtp_data_components": ("m.vtp", vtp_tetrahedron(data_components=1000000000), ["-n", "20"], 0, None,
+                            {"check": True}),
     # a version-5 legacy file whose offsets point outside the connectivity
     "offsets_damaged_vtk5": ("m.vtk", vtk5_text(CUBE_POINTS, CUBE_TRIANGLES, bad_offset=900), [], 2,
                              "do not exist", {}),
