@@ -26,13 +26,27 @@ packages="cmake ninja-build g++ libeigen3-dev libtbb-dev libopenvdb-dev libboost
   libvtk9-dev python3-vtk9 python3-dev"
 start=$(date +%s)
 log=$(mktemp)
-trap 'rm -f "$log"' EXIT
+carry=$(mktemp -d)
+trap 'rm -rf "$log" "$carry"' EXIT
+# Core has no VTK: when the main build (.ci/build.sh, build/) has made it from this same tree, the
+# root links that libSDFCageCore.a (passed in as the tool's /shared folder) and compiles only
+# what touches VTK: the module, the program and the Python wrapping. Without it, Core is
+# compiled there too (SDFCAGE_PLAIN_VTK_CORE=compile forces that).
+core_option=""
+if [ "${SDFCAGE_PLAIN_VTK_CORE:-reuse}" = reuse ] && [ -f build/lib/libSDFCageCore.a ] &&
+  [ -z "$(find Core -newer build/lib/libSDFCageCore.a -name '*.[ch]*' -print -quit)" ]; then
+  cp build/lib/libSDFCageCore.a "$carry/"
+  core_option="-DSDFCAGE_CORE_LIBRARY=/shared/libSDFCageCore.a"
+  echo "plain-vtk: linking the main build's Core (build/lib/libSDFCageCore.a)"
+else
+  echo "plain-vtk: compiling Core in the root too (no up-to-date build/lib/libSDFCageCore.a)"
+fi
 code=0
-bash "$fresh" . "set -e
+FRESH_SHARED="$carry" bash "$fresh" . "set -e
   apt-get update -qq
   apt-get install -y -qq --no-install-recommends $(echo $packages) >/dev/null
   cmake -S . -B build-vtk -G Ninja -DCMAKE_BUILD_TYPE=Release -DSDFCAGE_USE_PARAVIEW=OFF \
-    -DSDFCAGE_BUILD_TESTING=OFF -DPython3_EXECUTABLE=/usr/bin/python3 >/dev/null
+    -DSDFCAGE_BUILD_TESTING=OFF -DPython3_EXECUTABLE=/usr/bin/python3 $core_option >/dev/null
   cmake --build build-vtk -j2 | tail -n 2
   build-vtk/bin/sdfcage -n 200 -o /tmp/builtin_cage.vtp
   python3 -c \"
