@@ -38,4 +38,4 @@ stage() {
 # the fast part of Core's and the filters' tests; measured from a fresh clone at load 7-13: about 9
 # minutes of build, 514 s of tests), then plain VTK, each only while it fits.
 stage "sanitizer tests (.ci/asan.sh)" 1200 bash .ci/asan.sh
-stage "plain VTK build (.ci/plain-vtk.sh)" 900 bash .ci/plain-vtk.sh
+stage "plain VTK build (.ci/plain-vtk.sh)" 1200 bash .ci/plain-vtk.sh
