@@ -58,9 +58,9 @@ constexpr int ActiveRings = 2;
 constexpr int AngleDirections = 16;
 constexpr double AngleTilt = 30.0;
 constexpr int AngleSteps = 5;
-constexpr double AngleReach = 0.5;
+constexpr double AngleReach = 1.0;
 constexpr double AngleGain = 0.01;
-constexpr std::size_t AngleTries = 12;
+constexpr std::size_t AngleTries = 40;
 // The spacing energy's sweeps stop when one lowers it by less than this fraction.
 constexpr double SpacingConvergence = 0.002;
 // The default clearance at the default isovalue (c / 4), for Clearance <= 0.
@@ -1237,7 +1237,7 @@ public:
   /// a corner instead tries positions that raise the smallest angle of its ring (max-min):
   /// AngleDirections directions in the tangent plane of the ring (area-weighted normal), each
   /// also tilted by ±AngleTilt toward the normal, at reach, reach / 2, ... (AngleSteps lengths,
-  /// reach half the ring's mean edge). Candidates are taken in descending order of the ring's
+  /// reach AngleReach times the ring's mean edge; the first AngleTries candidates are checked). Candidates are taken in descending order of the ring's
   /// smallest angle, the first that every check of a descent step accepts is kept: the
   /// collision-free sweep (clearance to the input and to the rest of the cage, cut short where
   /// it must be and then judged again), the veto on the ring (shape, fold, self-intersection)
