@@ -1237,11 +1237,11 @@ public:
   /// a corner instead tries positions that raise the smallest angle of its ring (max-min):
   /// AngleDirections directions in the tangent plane of the ring (area-weighted normal), each
   /// also tilted by ±AngleTilt toward the normal, at reach, reach / 2, ... (AngleSteps lengths,
-  /// reach AngleReach times the ring's mean edge; the first AngleTries candidates are checked). Candidates are taken in descending order of the ring's
-  /// smallest angle, the first that every check of a descent step accepts is kept: the
-  /// collision-free sweep (clearance to the input and to the rest of the cage, cut short where
-  /// it must be and then judged again), the veto on the ring (shape, fold, self-intersection)
-  /// and the Hausdorff budget. Returns false when cancelled; `changes` counts the moves.
+  /// reach AngleReach times the ring's mean edge). Candidates are taken in descending order of
+  /// the ring's smallest angle (the first AngleTries of them), and the first that every check of
+  /// a descent step accepts is kept: the collision-free sweep (clearance to the input and to
+  /// the rest of the cage, cut short where it must be and then judged again), the veto on the
+  /// ring (shape, fold, self-intersection) and the Hausdorff budget. Returns false when cancelled; `changes` counts the moves.
   bool anglePass(OptimizeResult& r, long long& changes)
   {
     const double target = Opt.TargetMinimumAngle;
