@@ -51,6 +51,16 @@ constexpr int StallSweeps = 4;
 /// triangle with an angle below the target (the rest of the cage has had its full pass; this
 /// keeps a 500-vertex cage's later sweeps a fraction of the first one's cost).
 constexpr int ActiveRings = 2;
+// The angle-targeted relocation (Optimizer::anglePass): tangent directions tried, their tilt
+// toward the normal (degrees, each direction also tilted up and down), step lengths (halving
+// from AngleReach times the ring's mean edge), the smallest gain of the ring's smallest angle
+// (degrees) a candidate must promise, and the candidates checked at most per vertex.
+constexpr int AngleDirections = 16;
+constexpr double AngleTilt = 30.0;
+constexpr int AngleSteps = 5;
+constexpr double AngleReach = 1.0;
+constexpr double AngleGain = 0.01;
+constexpr std::size_t AngleTries = 40;
 // The spacing energy's sweeps stop when one lowers it by less than this fraction.
 constexpr double SpacingConvergence = 0.002;
 // The default clearance at the default isovalue (c / 4), for Clearance <= 0.
@@ -1212,6 +1222,112 @@ public:
     return true;
   }
 
+  /// Smallest angle (degrees) of the ring of L's vertex placed at p.
+  double ringMinimumAngle(const Local& L, const Vec3& p) const
+  {
+    double m = 180.0;
+    for (const auto& ids : L.RingIds)
+      m = std::min(m, minimumAngleOf(p, P[ids[1]], P[ids[2]]));
+    return m;
+  }
+
+  /// Angle-targeted relocation of the corners of the triangles still below the target (MIPS
+  /// with a target), worst first. The descent lowers the ring's summed MIPS energy, which can
+  /// settle with one needle left in the ring (widening it would cost its neighbours more); here
+  /// a corner instead tries positions that raise the smallest angle of its ring (max-min):
+  /// AngleDirections directions in the tangent plane of the ring (area-weighted normal), each
+  /// also tilted by ±AngleTilt toward the normal, at reach, reach / 2, ... (AngleSteps lengths,
+  /// reach AngleReach times the ring's mean edge). Candidates are taken in descending order of
+  /// the ring's smallest angle (the first AngleTries of them), and the first that every check of
+  /// a descent step accepts is kept: the collision-free sweep (clearance to the input and to
+  /// the rest of the cage, cut short where it must be and then judged again), the veto on the
+  /// ring (shape, fold, self-intersection) and the Hausdorff budget. Returns false when cancelled; `changes` counts the moves.
+  bool anglePass(OptimizeResult& r, long long& changes)
+  {
+    const double target = Opt.TargetMinimumAngle;
+    std::vector<std::pair<double, int>> bad;
+    for (std::size_t f = 0; f < T.size(); ++f)
+    {
+      const double a = triangleMinimumAngle(static_cast<int>(f));
+      if (a < target)
+        bad.emplace_back(a, static_cast<int>(f));
+    }
+    std::sort(bad.begin(), bad.end());
+    Local& L = work().L;
+    std::vector<std::pair<double, Vec3>> candidates;
+    for (std::size_t i = 0; i < bad.size(); ++i)
+    {
+      if (i % 16 == 0 && progressCancelled(Prog))
+        return false;
+      const int f = bad[i].second;
+      for (int k = 0; k < 3; ++k)
+      {
+        if (triangleMinimumAngle(f) >= target)
+          break; // mended
+        const int v = T[f][k];
+        double edgeSum = 0.0;
+        for (int g : VT[v])
+          for (int w : T[g])
+            edgeSum += (P[w] - P[v]).norm(); // each neighbour twice
+        const double reach = AngleReach * edgeSum / (2.0 * double(VT[v].size()));
+        if (!(reach > 0))
+          continue;
+        gather(v, reach, L);
+        const double before = ringMinimumAngle(L, L.P0);
+        Vec3 n = Vec3::Zero();
+        for (const auto& ids : L.RingIds)
+          n += (P[ids[1]] - L.P0).cross(P[ids[2]] - L.P0);
+        if (!(n.norm() > 0))
+          continue;
+        n.normalize();
+        const Vec3 e1 = (std::abs(n.x()) < 0.9 ? Vec3::UnitX() : Vec3::UnitY()).cross(n).normalized();
+        const Vec3 e2 = n.cross(e1);
+        candidates.clear();
+        for (int d = 0; d < AngleDirections; ++d)
+        {
+          const double phi = 2.0 * M_PI * d / AngleDirections;
+          const Vec3 tangent = std::cos(phi) * e1 + std::sin(phi) * e2;
+          for (int tilt = -1; tilt <= 1; ++tilt)
+          {
+            const double psi = tilt * AngleTilt * M_PI / 180.0;
+            const Vec3 dir = std::cos(psi) * tangent + std::sin(psi) * n;
+            double step = reach;
+            for (int s = 0; s < AngleSteps; ++s, step *= 0.5)
+            {
+              const Vec3 move = step * dir;
+              const double a = ringMinimumAngle(L, L.P0 + move);
+              if (a > before + AngleGain)
+                candidates.emplace_back(a, move);
+            }
+          }
+        }
+        // the best first; ties (equal angles) keep the generation order (deterministic)
+        std::stable_sort(candidates.begin(), candidates.end(),
+          [](const std::pair<double, Vec3>& x, const std::pair<double, Vec3>& y) { return x.first > y.first; });
+        const std::size_t tries = std::min<std::size_t>(candidates.size(), AngleTries);
+        for (std::size_t c = 0; c < tries; ++c)
+        {
+          const Vec3& move = candidates[c].second;
+          const double t = advance(L, move);
+          if (!(t > 0))
+            continue;
+          const Vec3 p = L.P0 + t * move;
+          if (t < 1.0 && !(ringMinimumAngle(L, p) > before + AngleGain))
+            continue;
+          if (!ringAcceptable(L, p) || !ringWithinBudget(L, p))
+            continue;
+          P[v] = p;
+          for (int g : VT[v])
+            updateBox(g);
+          ++r.AngleMoves;
+          ++changes;
+          break;
+        }
+      }
+    }
+    return true;
+  }
+
   /// Sorted neighbours of v.
   void neighbours(int v, std::vector<int>& out) const
   {
@@ -1660,6 +1776,8 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
         stage("repairing needles", b + 0.9 * (e - b), e);
         const auto t1 = std::chrono::steady_clock::now();
         cancelled = !opt.repairPass(r, repairs);
+        if (!cancelled && options.AngleRelocation)
+          cancelled = !opt.anglePass(r, repairs);
         r.FlipSeconds += seconds(t1);
       }
       ++r.Sweeps;

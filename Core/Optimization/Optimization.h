@@ -77,6 +77,11 @@ struct OptimizeOptions
   /// (checked like any change) and, to keep the vertex count, the longest edge of the cage is
   /// split at its midpoint (the surface does not change). 0 = no repair.
   double TargetMinimumAngle = 15.0;
+  /// MIPS with a target: after each repair pass, the corners of the triangles still below
+  /// TargetMinimumAngle try moves that raise the smallest angle of their ring (max-min angle
+  /// instead of the summed MIPS energy), checked like every move (collision-free sweep, veto,
+  /// Hausdorff budget).
+  bool AngleRelocation = true;
   /// Sweeps per round (one relocation pass, one flip pass and, MIPS, one repair pass each). A
   /// MIPS round ends early once no angle is below TargetMinimumAngle, a sweep changes nothing or
   /// the smallest angle has not grown for 4 sweeps;
@@ -103,6 +108,7 @@ struct OptimizeResult
   long long MovesVetoedByShape = 0;            ///< a ring triangle would flip or become a needle,
   long long MovesVetoedBySelfIntersection = 0; ///< the static self-intersection test failed
   long long MovesVetoedByFidelity = 0;         ///< a ring sample went beyond the Hausdorff budget
+  long long AngleMoves = 0;                    ///< moves of the angle-targeted relocation (AngleRelocation)
   long long Collapses = 0;                     ///< needle collapses (each paired with one edge split)
   long long RejectedCollapses = 0;             ///< needle collapses that broke a constraint
   int Sweeps = 0;                              ///< sweeps run (over all rounds)

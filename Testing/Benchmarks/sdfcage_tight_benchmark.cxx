@@ -263,12 +263,13 @@ int main(int argc, char** argv)
       small, hd, h0 > 0 ? h1 / h0 : 0.0, r.Seconds, ok ? "yes" : "NO", band[0], band[1]);
     if (verbose)
       std::printf("    mips: %d sweeps, moves %lld (rejected %lld: energy %lld, collision %lld, shape %lld, self %lld, "
-                  "fidelity %lld), flips %lld (vetoed %lld), collapses+splits %lld (vetoed %lld), sampled H %.5f -> "
+                  "fidelity %lld), flips %lld (vetoed %lld), collapses+splits %lld (vetoed %lld), angle moves %lld, "
+                  "sampled H %.5f -> "
                   "%.5f (budget %.5f, unit sphere); seconds: relocation %.2f, flips+repair %.2f, verification %.2f\n",
         r.Sweeps, r.Moves, r.RejectedMoves, r.MovesWithoutDescent, r.MovesCutByCollision, r.MovesVetoedByShape,
         r.MovesVetoedBySelfIntersection, r.MovesVetoedByFidelity, r.Flips, r.RejectedFlips, r.Collapses,
-        r.RejectedCollapses, r.HausdorffBefore, r.HausdorffAfter, r.HausdorffBudget, r.RelocationSeconds, r.FlipSeconds,
-        r.VerificationSeconds);
+        r.RejectedCollapses, r.AngleMoves, r.HausdorffBefore, r.HausdorffAfter, r.HausdorffBudget, r.RelocationSeconds,
+        r.FlipSeconds, r.VerificationSeconds);
     std::fflush(stdout);
   }
   return status;
