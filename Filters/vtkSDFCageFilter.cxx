@@ -64,6 +64,7 @@ vtkSDFCageFilter::vtkSDFCageFilter()
   this->Adaptivity = defaults.Adaptivity;
   this->MaximumRefinements = defaults.MaximumRefinements;
   this->MaximumEnvelopeWidenings = cageDefaults.MaximumEnvelopeWidenings;
+  this->ChooseIsoValueFirst = cageDefaults.ChooseIsoValueFirst ? 1 : 0;
   this->MaximumTopologyRepairs = defaults.MaximumTopologyRepairs;
   this->RequireTopology = defaults.RequireTopology ? 1 : 0;
   this->CoarseFirst = defaults.CoarseFirst ? 1 : 0;
@@ -182,6 +183,7 @@ sdfcage::CageOptions CageOptionsOf(vtkSDFCageFilter* f)
   options.Envelope.Adaptivity = f->GetAdaptivity();
   options.Envelope.MaximumRefinements = f->GetMaximumRefinements();
   options.MaximumEnvelopeWidenings = f->GetMaximumEnvelopeWidenings();
+  options.ChooseIsoValueFirst = f->GetChooseIsoValueFirst() != 0;
   options.Envelope.MaximumTopologyRepairs = f->GetMaximumTopologyRepairs();
   options.Envelope.RequireTopology = f->GetRequireTopology() != 0;
   options.Envelope.CoarseFirst = f->GetCoarseFirst() != 0;
@@ -577,6 +579,7 @@ void vtkSDFCageFilter::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Adaptivity: " << this->Adaptivity << "\n";
   os << indent << "MaximumRefinements: " << this->MaximumRefinements << "\n";
   os << indent << "MaximumEnvelopeWidenings: " << this->MaximumEnvelopeWidenings << "\n";
+  os << indent << "ChooseIsoValueFirst: " << (this->ChooseIsoValueFirst ? "On" : "Off") << "\n";
   os << indent << "MaximumTopologyRepairs: " << this->MaximumTopologyRepairs << "\n";
   os << indent << "RequireTopology: " << this->RequireTopology << "\n";
   os << indent << "CoarseFirst: " << this->CoarseFirst << "\n";

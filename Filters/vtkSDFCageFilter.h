@@ -247,6 +247,21 @@ public:
 
   ///@{
   /**
+   * With widening on (MaximumEnvelopeWidenings > 0) and the automatic voxel size, an input of
+   * more parts than the target can carry apart (4 vertices each) has its isovalue chosen first
+   * by probes on grids twice as coarse (parts and genus of the envelope, neither verified nor
+   * simplified), so that the envelopes that cannot reach the target are not built on the
+   * requested grid. Results EnvelopeProbes, IsoValuesSkipped, ProbeTime, WideningLog. Off: every
+   * widening is built in turn. Closed inputs are never probed. Default on (Core's
+   * CageOptions::ChooseIsoValueFirst).
+   */
+  vtkSetMacro(ChooseIsoValueFirst, vtkTypeBool);
+  vtkGetMacro(ChooseIsoValueFirst, vtkTypeBool);
+  vtkBooleanMacro(ChooseIsoValueFirst, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
    * A closed input whose envelope has another genus or number of parts (nearly touching parts
    * fused) gets its envelope rebuilt up to this many times, each round stronger: the facing-gap
    * rule beside the paper's active points, the most amplification the clearance allows, a finer
@@ -468,6 +483,7 @@ protected:
   double Adaptivity;
   int MaximumRefinements;
   int MaximumEnvelopeWidenings;
+  vtkTypeBool ChooseIsoValueFirst;
   int MaximumTopologyRepairs;
   vtkTypeBool RequireTopology;
   vtkTypeBool CoarseFirst;

@@ -141,6 +141,7 @@ std::string toJson(const RunReport& r)
   key("Adaptivity") << jsonNumber(r.Adaptivity);
   key("MaximumRefinements") << r.MaximumRefinements;
   key("CoarseFirst") << (r.CoarseFirst ? "true" : "false");
+  key("ChooseIsoValueFirst") << (r.ChooseIsoValueFirst ? "true" : "false");
   key("Optimize") << jsonString(r.Optimize);
   key("TargetSpacing") << jsonNumber(r.TargetSpacing);
   key("NumberOfIterations") << r.NumberOfIterations;
@@ -279,6 +280,12 @@ void printSummary(std::ostream& os, const RunReport& r)
   os << "\n";
   os << "voxel size  : " << number(r.number("VoxelSizeUsed")) << " (relative: the input scaled into the "
      << "unit sphere), isovalue " << number(r.IsoValue) << ", adaptivity " << number(r.Adaptivity) << "\n";
+  if (r.integer("EnvelopeProbes") > 0)
+  {
+    os << "probes      : " << r.integer("EnvelopeProbes") << " coarse-grid probe(s) chose the isovalue in "
+       << seconds(r.number("ProbeTime")) << ", " << r.integer("IsoValuesSkipped")
+       << " isovalue(s) ruled out and not built (--no-choose-iso-first: every widening built)\n";
+  }
   if (r.integer("EnvelopeWidenings") > 0)
   {
     os << "widened     : " << r.integer("EnvelopeWidenings") << " time(s), to isovalue "

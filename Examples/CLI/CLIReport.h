@@ -61,6 +61,7 @@ struct RunReport
   int NumberOfThreads = 0;
   bool UseActivePoints = true;
   bool CoarseFirst = true;
+  bool ChooseIsoValueFirst = true;
   double ActiveRadius = 0.0;
   double GeodesicThreshold = 0.0;
   double AmplificationAlpha = 0.0;

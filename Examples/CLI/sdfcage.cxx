@@ -110,6 +110,11 @@ void printUsage(std::ostream& os)
         "      --widenings N       inputs without a defined topology (open, soups) whose target is\n"
         "                          not reached: rebuild the envelope at twice the isovalue up to N\n"
         "                          times and keep the closest cage, default 3; 0 = off\n"
+        "      --choose-iso-first  with --widenings and the automatic voxel size, an input of more\n"
+        "                          parts than the target can carry apart (4 vertices each) has its\n"
+        "                          isovalue chosen first by probes on grids twice as coarse, so that\n"
+        "                          envelopes that cannot reach the target are not built (default\n"
+        "                          on; --no-choose-iso-first: every widening built in turn)\n"
         "      --topology-repairs N\n"
         "                          a closed input whose envelope fuses nearly touching parts\n"
         "                          (another genus or number of parts): rebuild it up to N times,\n"
@@ -188,6 +193,7 @@ struct Options
   int TopologyRepairs = -1; ///< -1 = the filter's default
   bool RequireTopology = false;
   int CoarseFirst = -1; ///< -1 = the filter's default
+  int ChooseIsoValueFirst = -1; ///< -1 = the filter's default
   double MemoryLimit = 0.0; ///< MiB, 0 = automatic (3/4 of the physical memory)
   bool NoActivePoints = false;
   double ActiveRadius = -1.0;      ///< -1 = the filter's default
@@ -434,6 +440,10 @@ bool parseBuildOption(ArgumentCursor& a, Options& o, vtkSDFCageFilter* limits)
     o.CoarseFirst = 1;
   else if (arg == "--no-coarse-first")
     o.CoarseFirst = 0;
+  else if (arg == "--choose-iso-first")
+    o.ChooseIsoValueFirst = 1;
+  else if (arg == "--no-choose-iso-first")
+    o.ChooseIsoValueFirst = 0;
   else if (arg == "--no-active-points")
     o.NoActivePoints = true;
   else if (arg == "--active-radius")
@@ -835,6 +845,8 @@ void configureFilter(vtkSDFCageFilter* filter, const Options& o, RunReport& r)
   filter->SetRequireTopology(o.RequireTopology ? 1 : 0);
   if (o.CoarseFirst >= 0)
     filter->SetCoarseFirst(o.CoarseFirst);
+  if (o.ChooseIsoValueFirst >= 0)
+    filter->SetChooseIsoValueFirst(o.ChooseIsoValueFirst);
   filter->SetMemoryLimit(o.MemoryLimit);
   filter->SetUseActivePoints(o.NoActivePoints ? 0 : 1);
   if (o.ActiveRadius >= 0)
@@ -865,6 +877,7 @@ void configureFilter(vtkSDFCageFilter* filter, const Options& o, RunReport& r)
 
   r.UseActivePoints = filter->GetUseActivePoints() != 0;
   r.CoarseFirst = filter->GetCoarseFirst() != 0;
+  r.ChooseIsoValueFirst = filter->GetChooseIsoValueFirst() != 0;
   r.ActiveRadius = filter->GetActiveRadius();
   r.GeodesicThreshold = filter->GetGeodesicThreshold();
   r.AmplificationAlpha = filter->GetAmplificationAlpha();

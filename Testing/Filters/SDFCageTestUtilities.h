@@ -141,6 +141,7 @@ int TestOptimizeFilter(const Context&);
 int TestOptimizeTightOptions(const Context&);
 int TestBuiltinShape(const Context&);
 int TestOpenInput(const Context&);
+int TestChooseIsoValueFirst(const Context&);
 int TestNoSurface(const Context&);
 int TestEmptyInput(const Context&);
 int TestAbort(const Context&);

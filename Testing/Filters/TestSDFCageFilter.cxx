@@ -442,6 +442,77 @@ int TestOpenInput(const Context&)
 }
 
 //------------------------------------------------------------------------------
+// ChooseIsoValueFirst reaches Core: 8 open cubes (8 parts, more than a 20-vertex target can carry
+// apart) with IsoValue 0.04 and one widening. On (the default, Core's), the isovalue 0.04 is
+// probed on a coarse grid and not built: one envelope, at 0.08. Off, 0.04 and then 0.08 are built.
+int TestChooseIsoValueFirst(const Context&)
+{
+  Checker c("ChooseIsoValueFirst");
+  vtkNew<vtkPoints> points;
+  vtkNew<vtkCellArray> polys;
+  // the cube [0, 0.8]^3 without its top face, outward triangles
+  const double corner[8][3] = { { 0, 0, 0 }, { 1, 0, 0 }, { 1, 1, 0 }, { 0, 1, 0 }, { 0, 0, 1 }, { 1, 0, 1 },
+    { 1, 1, 1 }, { 0, 1, 1 } };
+  const vtkIdType sides[10][3] = { { 0, 2, 1 }, { 0, 3, 2 }, { 0, 1, 5 }, { 0, 5, 4 }, { 2, 3, 7 }, { 2, 7, 6 },
+    { 1, 2, 6 }, { 1, 6, 5 }, { 3, 0, 4 }, { 3, 4, 7 } };
+  for (int cell = 0; cell < 8; ++cell)
+  {
+    const vtkIdType first = points->GetNumberOfPoints();
+    for (const auto& p : corner)
+    {
+      points->InsertNextPoint((cell & 1) + 0.8 * p[0], ((cell >> 1) & 1) + 0.8 * p[1], (cell >> 2) + 0.8 * p[2]);
+    }
+    for (const auto& t : sides)
+    {
+      const vtkIdType ids[3] = { first + t[0], first + t[1], first + t[2] };
+      polys->InsertNextCell(3, ids);
+    }
+  }
+  vtkNew<vtkPolyData> cubes;
+  cubes->SetPoints(points);
+  cubes->SetPolys(polys);
+
+  const sdfcage::CageOptions core;
+  double isoValueUsed[2] = { 0, 0 };
+  for (const int on : { 1, 0 })
+  {
+    vtkNew<vtkSDFCageFilter> filter;
+    if (on)
+    {
+      c.Check((filter->GetChooseIsoValueFirst() != 0) == core.ChooseIsoValueFirst, "ChooseIsoValueFirst default = Core's");
+      c.Check(filter->GetChooseIsoValueFirst() != 0, "ChooseIsoValueFirst on by default");
+    }
+    else
+    {
+      filter->ChooseIsoValueFirstOff();
+    }
+    filter->SetInputData(cubes);
+    filter->SetTargetNumberOfVertices(20);
+    filter->SetIsoValue(0.04);
+    filter->SetMaximumEnvelopeWidenings(1);
+    filter->Update();
+    const std::string label = on ? "on: " : "off: ";
+    std::cout << "  " << label << filter->GetResultText("WideningLog") << "\n";
+    c.Check(std::string(filter->GetStatusString()) == "Ok", label + "status Ok");
+    c.Check(filter->GetEnclosureVerified(), label + "enclosure verified");
+    c.Check(filter->GetResultNumber("InputComponents") == 8, label + "8 input parts");
+    c.Check(filter->GetResultNumber("EnvelopeProbes") == (on ? 1 : 0),
+      label + "EnvelopeProbes " + Str(filter->GetResultNumber("EnvelopeProbes")));
+    c.Check(filter->GetResultNumber("IsoValuesSkipped") == (on ? 1 : 0),
+      label + "IsoValuesSkipped " + Str(filter->GetResultNumber("IsoValuesSkipped")));
+    c.Check(filter->GetResultNumber("EnvelopeAttempts") == (on ? 1 : 2),
+      label + "EnvelopeAttempts " + Str(filter->GetResultNumber("EnvelopeAttempts")));
+    c.Check((std::string(filter->GetResultText("WideningLog")).find("probed") != std::string::npos) == (on != 0),
+      label + "the widening log lists a probe only when on");
+    c.Check(FieldNumber(filter->GetOutput(0), "EnvelopeProbes") == (on ? 1 : 0), label + "field data EnvelopeProbes");
+    isoValueUsed[on] = filter->GetResultNumber("IsoValueUsed");
+  }
+  c.Check(std::abs(isoValueUsed[0] - 0.08) < 1e-12 && std::abs(isoValueUsed[1] - 0.08) < 1e-12,
+    "both cages come from the isovalue 0.08 (" + Str(isoValueUsed[1]) + ", " + Str(isoValueUsed[0]) + ")");
+  return c.Result();
+}
+
+//------------------------------------------------------------------------------
 int TestNoSurface(const Context&)
 {
   Checker c("NoSurface");

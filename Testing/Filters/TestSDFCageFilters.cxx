@@ -50,6 +50,7 @@ int main(int argc, char* argv[])
     { "OptimizeTightOptions", TestOptimizeTightOptions },
     { "BuiltinShape", TestBuiltinShape },
     { "OpenInput", TestOpenInput },
+    { "ChooseIsoValueFirst", TestChooseIsoValueFirst },
     { "NoSurface", TestNoSurface },
     { "EmptyInput", TestEmptyInput },
     { "Abort", TestAbort },

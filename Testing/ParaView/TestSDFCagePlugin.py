@@ -101,6 +101,8 @@ Delete(fresh)
 plane = Plane(XResolution=4, YResolution=4)  # an open sheet: 16 boundary edges
 sheet_cage = SDFCage(Input=plane, TargetNumberOfVertices=60)
 check(sheet_cage.SignMode == "Auto", "SignMode default Auto (got %s)" % sheet_cage.SignMode)
+check(sheet_cage.ChooseIsoValueFirst == 1,
+      "ChooseIsoValueFirst default on (got %s)" % sheet_cage.ChooseIsoValueFirst)
 sheet_cage.UpdatePipeline()
 sheet_out = servermanager.Fetch(sheet_cage)
 check(sheet_out.GetNumberOfPoints() == 60, "open sheet: a 60-vertex cage (got %d)" % sheet_out.GetNumberOfPoints())
