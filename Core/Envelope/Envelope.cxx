@@ -657,8 +657,11 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
       std::string why;
       double clearance = 0.0;
       std::vector<double> distances;
-      const bool ok = verifyEnclosure(
-        unitInput, envelope, delta, clearance, why, &distances, progress, options.ExactEnvelopeClearance, &tree());
+      // (deferred: accepted as extracted, the caller verifies it if it keeps it)
+      const bool ok = options.DeferVerification ||
+        verifyEnclosure(
+          unitInput, envelope, delta, clearance, why, &distances, progress, options.ExactEnvelopeClearance, &tree());
+      result.VerificationDeferred = options.DeferVerification;
       ++attempt;
       if (ok)
       {
@@ -689,7 +692,7 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
       return ok;
     };
     IsosurfaceOutput iso = computeIsosurface(unitInput, h, c, options.KeepDistanceField, progress, adaptivities,
-      amplification, &judge, 4, result.SignUsed, winding ? &tree() : nullptr);
+      amplification, &judge, 4, result.SignUsed, flood ? nullptr : &tree());
     result.WindingSeconds += iso.WindingSeconds;
     result.WindingEvaluations += iso.WindingEvaluations;
     result.AmplifiedVoxels = iso.AmplifiedVoxels;
@@ -760,7 +763,7 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
         }
         result.TopologyWarning = w.str();
       }
-      result.EnclosureVerified = true;
+      result.EnclosureVerified = !result.VerificationDeferred;
       result.State = Status::Ok;
       result.Message.clear();
       tree();

@@ -74,6 +74,12 @@ struct EnvelopeOptions
   /// Measure the envelope's exact minimum clearance (costly on a dense envelope) instead of
   /// certifying that it is at least the clearance (a certified lower bound is reported then).
   bool ExactEnvelopeClearance = false;
+  /// Accept the extracted envelope without verifying it (VerificationDeferred in the result,
+  /// EnclosureVerified false): for a caller that verifies it later, and only if it keeps it (the
+  /// pipeline's envelopes that a wider one may replace, see CageOptions::DeferEnvelopeVerification).
+  /// Outer boundary, pockets and parts as usual; no adaptive re-extraction (that needs the
+  /// verification's findings).
+  bool DeferVerification = false;
   /// Shape-aware envelope (paper §3.1): detect active points (parts of the surface that nearly
   /// touch other parts) and extract the envelope from the amplified field phi * xi, which lies
   /// closer to the input there (down to c / alpha) so that nearly touching parts stay separate.
@@ -126,6 +132,7 @@ struct EnvelopeResult
   double MinimumClearance =
     0.0; ///< exact min distance to the input (ExactEnvelopeClearance) or a certified lower bound >= delta, unit-sphere units
   bool EnclosureVerified = false;    ///< clearance >= delta, input inside, closed manifold
+  bool VerificationDeferred = false; ///< accepted unverified (EnvelopeOptions::DeferVerification)
   int RemovedPockets = 0;            ///< trapped air pockets (inner components) removed
   int Components = 0;                ///< components of the kept envelope
   int Genus = 0;                     ///< genus of the kept envelope

@@ -91,8 +91,11 @@ bool prepareInput(const PolygonMesh& input, const CageOptions& options, Progress
 /// target is not simplified (it could not reach the target; the time is better spent on the
 /// wider one), nor is a simplification pursued past its ordinary pass when that ends well above
 /// the target (SimplifyOptions::GiveUpAbove).
-CageResult generateOnce(
-  const PreparedInput& prepared, const CageOptions& options, Progress* progress, bool mayWiden)
+/// `allowDefer`: the envelope's verification may wait until its cage is known to be kept
+/// (CageOptions::DeferEnvelopeVerification); a result that stops short of the target is then
+/// returned provisional (VerificationDeferred: neither envelope nor cage verified).
+CageResult generateOnce(const PreparedInput& prepared, const CageOptions& options, Progress* progress,
+  bool mayWiden, bool allowDefer = true)
 {
   CageResult result;
   result.IsoValueUsed = options.Envelope.IsoValue;
@@ -112,6 +115,7 @@ CageResult generateOnce(
   if (mayWiden && !result.Defects.usable() && options.TargetNumberOfVertices > 0)
   {
     envelopeOptions.VertexBudget = options.TargetNumberOfVertices; // too complex: not even verified
+    envelopeOptions.DeferVerification = allowDefer && options.DeferEnvelopeVerification;
   }
   EnvelopeResult env = buildEnvelope(
     unit, envelopeOptions, progress, options.TargetNumberOfVertices > 0 ? 0.45 : 1.0, result.Defects.usable() ? 1 : 0);
@@ -212,6 +216,60 @@ CageResult generateOnce(
     result.VerticesReached = result.Simplification.VerticesReached;
     result.TargetReached = result.Simplification.TargetReached;
     result.StopReason = result.Simplification.StopReason;
+    if (env.VerificationDeferred)
+    {
+      if (result.Simplification.Cancelled || progressCancelled(progress))
+      {
+        // nothing here is verified, and a cancel does not wait for it
+        result = CageResult();
+        result.Defects = prepared.Defects;
+        result.State = Status::Cancelled;
+        result.Message = "cancelled while an envelope was simplified: no cage";
+        result.TotalSeconds = seconds(start);
+        return result;
+      }
+      if (!result.TargetReached)
+      {
+        // a wider envelope follows; this one is verified only if it is kept (generateCage)
+        result.VerificationDeferred = true;
+        result.State = Status::Ok;
+        result.TotalSeconds = seconds(start);
+        return result;
+      }
+      // kept: the envelope's verification now, as buildEnvelope would have run it
+      progressStage(progress, "verifying enclosure", 0.95, 0.96);
+      const auto t0 = std::chrono::steady_clock::now();
+      std::vector<double> distances;
+      std::string why;
+      double clearance = 0.0;
+      const bool envelopeOk = verifyEnclosure(unit, env.Envelope, so.Clearance, clearance, why, &distances, progress,
+        envelopeOptions.ExactEnvelopeClearance, &tree);
+      result.VerificationSeconds += seconds(t0);
+      if (!envelopeOk)
+      {
+        if (progressCancelled(progress))
+        {
+          result = CageResult();
+          result.Defects = prepared.Defects;
+          result.State = Status::Cancelled;
+          result.Message = "cancelled while the envelope was verified: no cage";
+          result.TotalSeconds = seconds(start);
+          return result;
+        }
+        // the ordinary way: verified first (and its adaptive merges repaired where they fail)
+        CageResult again = generateOnce(prepared, options, progress, mayWiden, false);
+        again.TotalSeconds += seconds(start);
+        return again;
+      }
+      result.EnclosureVerified = true;
+      result.MinimumClearanceRelative = clearance;
+      result.MinimumClearance = n.lengthToInput(clearance);
+      result.EnvelopeDistanceToInput.resize(distances.size());
+      for (std::size_t i = 0; i < distances.size(); ++i)
+      {
+        result.EnvelopeDistanceToInput[i] = n.lengthToInput(distances[i]);
+      }
+    }
     // independent re-verification of the final cage (exact distances, winding numbers). It runs
     // even after a cancel: the partial cage is valid and usable. But a cancel must answer at
     // once, and a cage cut short early is large (15,000 vertices and more take a second or two
@@ -475,6 +533,26 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
     {
       break;
     }
+  }
+  if (best.VerificationDeferred && !progressCancelled(progress))
+  {
+    // no envelope reached the target and this one, the closest, is kept: built again the
+    // ordinary way (verified first, then its cage), with everything else as it was
+    CageOptions kept = first;
+    kept.Envelope.IsoValue = best.IsoValueUsed;
+    const int widenings = best.EnvelopeWidenings;
+    // (a result is deferred only where a wider envelope could follow it)
+    CageResult verified = generateOnce(prepared, kept, progress, true, false);
+    ++attempts;
+    verified.EnvelopeWidenings = widenings;
+    best = std::move(verified);
+  }
+  else if (best.VerificationDeferred)
+  {
+    best = CageResult();
+    best.Defects = prepared.Defects;
+    best.State = Status::Cancelled;
+    best.Message = "cancelled";
   }
   if ((tried > 0 || skipped > 0) && !best.TargetReached && best.State == Status::Ok)
   {

@@ -49,6 +49,15 @@ struct CageOptions
   /// than its voxel); it only decides which envelopes are not built. Closed inputs are never
   /// probed.
   bool ChooseIsoValueFirst = true;
+  /// With widening on, an input without a defined topology: an envelope that a wider one may
+  /// still replace is simplified before it is verified (EnvelopeOptions::DeferVerification), and
+  /// verified only once its cage reaches the target (or is kept after the widenings): the
+  /// envelopes that are thrown away are never verified (on the 100k-face soup of
+  /// Testing/Benchmarks/anymesh_benchmark.py that is a 0.5 s verification of the 0.04 envelope
+  /// whose cage stops at 657 vertices). Nothing unverified is ever output: an envelope that fails
+  /// the late verification is built again the ordinary way (verified first, adaptivity repaired),
+  /// and every cage is verified as before. The cages are the same either way.
+  bool DeferEnvelopeVerification = true;
 };
 
 struct CageResult
@@ -121,6 +130,9 @@ struct CageResult
   int IsoValuesSkipped = 0;   ///< isovalues the probes ruled out (included in EnvelopeWidenings)
   double ProbeSeconds = 0.0;  ///< time of the probes
   int EnvelopeAttempts = 0;   ///< envelopes built on the requested grid (each one full run)
+  /// A provisional result (CageOptions::DeferEnvelopeVerification): its envelope is not verified
+  /// yet, nor its cage; never returned by generateCage.
+  bool VerificationDeferred = false;
   ScalarImage DistanceField;         ///< input coordinates and units, when requested
   ScalarImage ModifiedDistanceField; ///< phi * xi, input units, when requested and active points exist
   Normalization Normalize;

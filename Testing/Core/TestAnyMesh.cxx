@@ -3,6 +3,7 @@
 // each judged by the independent CGAL referee (exact predicates) against the input as given.
 #include "CoreTestPrinters.h"
 #include "ExactCheck.h"
+#include "Envelope/SDFIsosurface.h"
 #include "Mesh/Mesh.h"
 #include "Mesh/Shapes.h"
 #include "Mesh/Validation.h"
@@ -12,8 +13,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
+#include <iostream>
 #include <string>
 #include <vector>
 
@@ -355,6 +358,64 @@ TEST(AnyMeshWidening, OffKeepsTheIsovalueOnReportsTheWiderEnvelope)
   EXPECT_TRUE(torus.WideningLog.empty());
 }
 
+TEST(AnyMeshWidening, DeferredVerificationGivesTheSameVerifiedCage)
+{
+  // CageOptions::DeferEnvelopeVerification: the envelopes a wider one may replace are simplified
+  // unverified and verified only if kept: the same verified cage and envelope as without
+  // deferral. An open torus (two faces missing: widened like any soup) cannot be caged with 12
+  // vertices at any isovalue, so every envelope is simplified and misses the target; the widest
+  // one allowed is simplified in full and never deferred.
+  TriangleMesh torus = makeTorus(Vec3(0, 0, 0), 0.7, 0.25, 48, 24);
+  torus.Triangles.resize(torus.Triangles.size() - 2);
+  const PolygonMesh input = PolygonMesh::fromTriangles(torus);
+  for (int widenings : { 1, 2 })
+  {
+    CageOptions options;
+    options.Envelope.IsoValue = 0.04; // small envelopes: a quick test
+    options.TargetNumberOfVertices = 12;
+    options.MaximumEnvelopeWidenings = widenings;
+    options.ChooseIsoValueFirst = false;
+    options.DeferEnvelopeVerification = false;
+    const CageResult plain = generateCage(input, options);
+    options.DeferEnvelopeVerification = true;
+    const CageResult deferred = generateCage(input, options);
+    const std::string what = deferred.WideningLog;
+    ASSERT_EQ(plain.State, Status::Ok) << what << ": " << plain.Message;
+    ASSERT_EQ(deferred.State, Status::Ok) << what << ": " << deferred.Message;
+    EXPECT_FALSE(deferred.TargetReached) << what;
+    std::cout << "[ deferred ] widenings " << widenings << ": kept isovalue " << deferred.IsoValueUsed << ", "
+              << deferred.VerticesReached << " vertices, " << deferred.EnvelopeAttempts << " attempts (plain "
+              << plain.EnvelopeAttempts << "): " << what << "\n";
+    EXPECT_FALSE(deferred.VerificationDeferred) << what;
+    EXPECT_TRUE(deferred.EnclosureVerified) << what;
+    EXPECT_EQ(deferred.IsoValueUsed, plain.IsoValueUsed) << what;
+    EXPECT_EQ(deferred.EnvelopeWidenings, plain.EnvelopeWidenings) << what;
+    // one more attempt when the kept envelope was a deferred one (built again, verified)
+    EXPECT_EQ(deferred.EnvelopeAttempts,
+      plain.EnvelopeAttempts + (deferred.IsoValueUsed < options.Envelope.IsoValue * (1 << widenings) ? 1 : 0))
+      << what;
+    EXPECT_EQ(deferred.Cage.Points, plain.Cage.Points) << what;
+    EXPECT_EQ(deferred.Cage.Triangles, plain.Cage.Triangles) << what;
+    EXPECT_EQ(deferred.Envelope.Points, plain.Envelope.Points) << what;
+    ASSERT_EQ(deferred.EnvelopeDistanceToInput.size(), deferred.Envelope.Points.size()) << what;
+    EXPECT_EQ(deferred.EnvelopeDistanceToInput, plain.EnvelopeDistanceToInput) << what;
+    EXPECT_EQ(deferred.MinimumClearance, plain.MinimumClearance) << what;
+    // the first envelope was simplified without a verification: its log entry's verification
+    // time is the bare timer's (below a microsecond here, about 0.2 ms or more when verified)
+    auto firstVerification = [](const std::string& log) {
+      const std::size_t at = log.find("verification ");
+      return at == std::string::npos ? -1.0 : std::stod(log.substr(at + 13));
+    };
+    EXPECT_GE(firstVerification(what), 0.0) << what;
+    EXPECT_LT(firstVerification(what), 1e-4) << what;
+    EXPECT_GT(firstVerification(plain.WideningLog), 1e-4) << plain.WideningLog;
+    const exact::ExactReport e = exact::exactCheck(asGiven(input), deferred.Cage, 0.0);
+    EXPECT_TRUE(e.Encloses) << exact::toJson(e);
+    EXPECT_EQ(e.InputIntersections, 0) << what;
+    EXPECT_EQ(e.SelfIntersections, 0) << what;
+  }
+}
+
 /// 125 small open boxes (two triangles missing each) on a 5 x 5 x 5 lattice, 0.1 apart (about
 /// 0.1 in unit-sphere units too): a soup whose envelope keeps the boxes apart (125 parts: 500
 /// vertices or more) until the isovalue bridges the gaps (0.08).
@@ -534,3 +595,43 @@ TEST(AnyMeshRepairs, ForcedRulesAreHonoured)
 }
 
 } // namespace
+
+TEST(AnyMeshField, TheUnsignedBandIsExactWhereTrianglesAreSmallerThanVoxels)
+{
+  // The unsigned narrow band from the input's tree (computeIsosurface with the tree: one exact
+  // query per voxel near the input) on a sheet of 80,000 triangles eight times smaller than the
+  // voxel: over the sheet's flat middle the distance is |z|, linear, so the isosurface at `iso`
+  // interpolated from exact values lies exactly at distance iso (to float rounding).
+  const TriangleMesh flat = sheet(200); // [0,1]^2, z = 0
+  TriangleMesh m = flat;
+  for (Vec3& p : m.Points)
+    p = 0.5 * p; // [0,0.5]^2: triangles 0.0025 across
+  const TriangleTree tree(m);
+  const double h = 0.02, iso = 0.04;
+  const IsosurfaceOutput own =
+    computeIsosurface(m, h, iso, false, nullptr, { 0.0 }, nullptr, nullptr, 3, SignMode::Unsigned, &tree);
+  ASSERT_TRUE(own.Error.empty()) << own.Error;
+  ASSERT_EQ(own.Surfaces.size(), 1u);
+  const IsosurfaceOutput vdb =
+    computeIsosurface(m, h, iso, false, nullptr, { 0.0 }, nullptr, nullptr, 3, SignMode::Unsigned, nullptr);
+  ASSERT_EQ(vdb.Surfaces.size(), 1u);
+  auto worst = [&](const TriangleMesh& s, std::size_t& middle) {
+    double e = 0.0;
+    middle = 0;
+    for (const Vec3& p : s.Points)
+    {
+      if (p.x() < 0.1 || p.x() > 0.4 || p.y() < 0.1 || p.y() > 0.4)
+        continue;
+      ++middle;
+      e = std::max(e, std::abs(tree.distance(p) - iso));
+    }
+    return e;
+  };
+  std::size_t middleOwn = 0, middleVdb = 0;
+  const double eOwn = worst(own.Surfaces[0], middleOwn), eVdb = worst(vdb.Surfaces[0], middleVdb);
+  std::cout << "[ band     ] isosurface over the sheet's middle: |d - iso| at most " << eOwn << " (own band, "
+            << own.DistanceFieldSeconds << " s), " << eVdb << " (OpenVDB's meshToVolume, " << vdb.DistanceFieldSeconds
+            << " s)\n";
+  EXPECT_GT(middleOwn, 100u); // both sides of the middle
+  EXPECT_LT(eOwn, 1e-5 * iso);
+}
