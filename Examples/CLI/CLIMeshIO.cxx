@@ -36,6 +36,7 @@
 #include <fstream>
 #include <iomanip>
 #include <sstream>
+#include <vector>
 
 namespace fs = std::filesystem;
 
@@ -161,14 +162,118 @@ bool checkXMLComponents(const std::string& bytes, std::string& why)
 /// section made it read past its buffer (a fuzzed file crashed it). Walk the section here first:
 /// every cell must fit in it. `start` is where the values begin (the line after the header);
 /// sections VTK cannot read at all (too short, not numbers) are left for VTK to refuse. Files of
-/// version 5 and later (an OFFSETS line follows) are checked after reading (checkCellArrays).
-bool checkLegacyCells(const std::string& bytes, std::size_t start, bool binary, double declaredValues,
-  const std::string& keyword, int lineNumber, std::string& why)
+/// version 5 and later (an OFFSETS line follows): checkLegacyCellsV5.
+/// Version 5 and later ("POLYGONS n size", then "OFFSETS type" with n offsets and "CONNECTIVITY
+/// type" with `size` point ids): vtkPolyDataReader trusts the offsets, so a damaged list (a
+/// fuzzed file: offsets cut short by bytes that are no numbers) made it read past its buffer.
+/// Both lists must be there in full, the offsets start at 0, never decrease and end at `size`.
+bool checkLegacyCellsV5(const std::string& bytes, std::size_t at, bool binary, double declaredOffsets,
+  double declaredValues, const std::string& keyword, int lineNumber, std::string& why)
+{
+  const auto n = static_cast<std::size_t>(declaredOffsets); // both fit: checked against the file size
+  const auto values = static_cast<std::size_t>(declaredValues);
+  auto refuse = [&](const std::string& what) {
+    why = "line " + std::to_string(lineNumber) + ": " + keyword + " " + what + " (the file is damaged)";
+    return false;
+  };
+  // "WORD type" at `at`: the type's size in binary files, and `at` past the line
+  auto header = [&](const char* word, std::size_t& width) {
+    const std::size_t length = std::strlen(word);
+    at = bytes.find_first_not_of(" \t\r\n", at);
+    if (at == std::string::npos || bytes.compare(at, length, word) != 0)
+    {
+      return false;
+    }
+    const std::size_t eol = bytes.find('\n', at);
+    if (eol == std::string::npos)
+    {
+      return false;
+    }
+    const std::string type = bytes.substr(at + length, eol - at - length);
+    width = type.find("64") != std::string::npos ? 8 : 4;
+    at = eol + 1;
+    return true;
+  };
+  // `count` integers from `at` (big-endian of `width` bytes in binary files)
+  auto read = [&](std::size_t count, std::size_t width, std::vector<long long>* out) {
+    if (binary)
+    {
+      if (at > bytes.size() || (bytes.size() - at) / width < count)
+      {
+        return false;
+      }
+      if (out)
+      {
+        const auto* b = reinterpret_cast<const unsigned char*>(bytes.data() + at);
+        for (std::size_t i = 0; i < count; ++i)
+        {
+          std::uint64_t v = 0;
+          for (std::size_t k = 0; k < width; ++k)
+          {
+            v = (v << 8) | b[i * width + k];
+          }
+          out->push_back(width == 8 ? static_cast<long long>(v) : static_cast<std::int32_t>(v));
+        }
+      }
+      at += count * width;
+      return true;
+    }
+    const char* cursor = bytes.c_str() + std::min(at, bytes.size());
+    for (std::size_t i = 0; i < count; ++i)
+    {
+      char* end = nullptr;
+      errno = 0;
+      const long long v = std::strtoll(cursor, &end, 10);
+      if (end == cursor || errno != 0)
+      {
+        return false;
+      }
+      cursor = end;
+      if (out)
+      {
+        out->push_back(v);
+      }
+    }
+    at = static_cast<std::size_t>(cursor - bytes.c_str());
+    return true;
+  };
+  std::size_t width = 4;
+  std::vector<long long> offsets;
+  offsets.reserve(n);
+  if (!header("OFFSETS", width) || !read(n, width, &offsets))
+  {
+    return refuse("declares " + std::to_string(n) + " offsets, but fewer are there");
+  }
+  if (!offsets.empty() && offsets.front() != 0)
+  {
+    return refuse("offsets must start at 0");
+  }
+  for (std::size_t i = 1; i < offsets.size(); ++i)
+  {
+    if (offsets[i] < offsets[i - 1])
+    {
+      return refuse("offset " + std::to_string(i + 1) + " is smaller than the one before");
+    }
+  }
+  if (!offsets.empty() && static_cast<unsigned long long>(offsets.back()) != values)
+  {
+    return refuse("offsets end at " + std::to_string(offsets.back()) + ", not at the " + std::to_string(values) +
+      " point ids declared");
+  }
+  if (!header("CONNECTIVITY", width) || !read(values, width, nullptr))
+  {
+    return refuse("declares " + std::to_string(values) + " point ids, but fewer are there");
+  }
+  return true;
+}
+
+bool checkLegacyCells(const std::string& bytes, std::size_t start, bool binary, double declaredCells,
+  double declaredValues, const std::string& keyword, int lineNumber, std::string& why)
 {
   std::size_t first = bytes.find_first_not_of(" \t\r\n", start);
   if (first != std::string::npos && bytes.compare(first, 7, "OFFSETS") == 0)
   {
-    return true;
+    return checkLegacyCellsV5(bytes, start, binary, declaredCells, declaredValues, keyword, lineNumber, why);
   }
   const auto values = static_cast<std::size_t>(declaredValues); // fits: checked against the file size
   auto refuse = [&](std::size_t cell, long long points, std::size_t at) {
@@ -350,7 +455,7 @@ bool checkLegacyCounts(const std::string& bytes, std::string& why)
       {
         return false;
       }
-      if (!checkLegacyCells(bytes, pos, binary, values, keyword, lineNumber, why))
+      if (!checkLegacyCells(bytes, pos, binary, n, values, keyword, lineNumber, why))
       {
         return false;
       }

@@ -235,9 +235,13 @@ CASES = {
                              "declares 1000000000 components", {}),
     "vtp_data_components": ("m.vtp", vtp_tetrahedron(data_components=1000000000), ["-n", "20"], 0, None,
                             {"check": True}),
-    # a version-5 legacy file whose offsets point outside the connectivity
+    # a version-5 legacy file whose offsets point outside the connectivity (refused before VTK reads it)
     "offsets_damaged_vtk5": ("m.vtk", vtk5_text(CUBE_POINTS, CUBE_TRIANGLES, bad_offset=900), [], 2,
-                             "do not exist", {}),
+                             "the file is damaged", {}),
+    # offsets cut short by bytes that are no numbers (a fuzzed file: vtkPolyDataReader read past its
+    # buffer)
+    "offsets_cut_short_vtk5": ("m.vtk", vtk5_text(CUBE_POINTS, CUBE_TRIANGLES).replace(b"9 12", b"9\xff 12"), [], 2,
+                               "fewer are there", {}),
     # OBJ's relative (negative) indices are valid OBJ: a tetrahedron, caged
     "relative_indices_obj": ("m.obj", b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
                              b"f -1 -2 -3\nf -4 -3 -2\nf -4 -2 -1\nf -4 -1 -3\n", ["-n", "20"], 0, None,
