@@ -218,15 +218,18 @@ CageResult generateOnce(const PreparedInput& prepared, const CageOptions& option
     result.StopReason = result.Simplification.StopReason;
     if (env.VerificationDeferred)
     {
+      // a cancel here leaves nothing verified, and does not wait for a verification: no cage
+      auto cancelledWithoutCage = [&](const char* message) {
+        CageResult cancelled;
+        cancelled.Defects = prepared.Defects;
+        cancelled.State = Status::Cancelled;
+        cancelled.Message = message;
+        cancelled.TotalSeconds = seconds(start);
+        return cancelled;
+      };
       if (result.Simplification.Cancelled || progressCancelled(progress))
       {
-        // nothing here is verified, and a cancel does not wait for it
-        result = CageResult();
-        result.Defects = prepared.Defects;
-        result.State = Status::Cancelled;
-        result.Message = "cancelled while an envelope was simplified: no cage";
-        result.TotalSeconds = seconds(start);
-        return result;
+        return cancelledWithoutCage("cancelled while an envelope was simplified: no cage");
       }
       if (!result.TargetReached)
       {
@@ -249,12 +252,7 @@ CageResult generateOnce(const PreparedInput& prepared, const CageOptions& option
       {
         if (progressCancelled(progress))
         {
-          result = CageResult();
-          result.Defects = prepared.Defects;
-          result.State = Status::Cancelled;
-          result.Message = "cancelled while the envelope was verified: no cage";
-          result.TotalSeconds = seconds(start);
-          return result;
+          return cancelledWithoutCage("cancelled while the envelope was verified: no cage");
         }
         // the ordinary way: verified first (and its adaptive merges repaired where they fail)
         CageResult again = generateOnce(prepared, options, progress, mayWiden, false);
