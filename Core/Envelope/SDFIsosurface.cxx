@@ -696,26 +696,7 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
   IsosurfaceOutput out;
   auto t0 = std::chrono::steady_clock::now();
 
-  // mesh in index space (voxel centres at integer coordinates)
-  std::vector<openvdb::Vec3s> points(unitMesh.Points.size());
-  for (std::size_t i = 0; i < points.size(); ++i)
-  {
-    const Vec3 p = unitMesh.Points[i] / voxelSize;
-    points[i] = openvdb::Vec3s(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
-  }
-  // The triangles go to OpenVDB in Morton order of their centroids (cells of two voxels): its
-  // voxelization gives each thread scratch trees that spatially coherent triangles keep small
-  // and its accessors' caches hit (armadillo_midsub4x: 4.2 -> 2.4 s, armadillo 1.39 -> 1.19 s).
-  // The closest-triangle grid then holds positions in this order: `order` maps them back.
-  const std::vector<int> order = mortonOrder(points, unitMesh.Triangles);
-  std::vector<openvdb::Vec3I> tris(order.size());
-  for (std::size_t f = 0; f < tris.size(); ++f)
-  {
-    const Triangle& t = unitMesh.Triangles[order[f]];
-    tris[f] = openvdb::Vec3I(t[0], t[1], t[2]);
-  }
   std::atomic<bool> expanding{ false };
-  const CancellableMeshAdapter adapter(points, tris, progress, &expanding);
   auto transform = openvdb::math::Transform::createLinearTransform(voxelSize);
 
   // The isosurface at `iso` needs values up to iso plus one voxel. Corners beyond the band read the
@@ -763,6 +744,31 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
     const std::size_t n = unitMesh.Triangles.size();
     ownBand = static_cast<double>(n) * voxelSize * voxelSize > area && 10 * small >= 9 * n && pieces < 5.0e7;
   }
+  // OpenVDB's input (not needed by the band from the tree): the mesh in index space (voxel centres
+  // at integer coordinates), its triangles in Morton order of their centroids (cells of two voxels):
+  // OpenVDB's voxelization gives each thread scratch trees that spatially coherent triangles keep
+  // small and its accessors' caches hit (armadillo_midsub4x: 4.2 -> 2.4 s, armadillo 1.39 -> 1.19 s).
+  // The closest-triangle grid then holds positions in this order: `order` maps them back.
+  std::vector<openvdb::Vec3s> points;
+  std::vector<int> order;
+  std::vector<openvdb::Vec3I> tris;
+  if (!ownBand)
+  {
+    points.resize(unitMesh.Points.size());
+    for (std::size_t i = 0; i < points.size(); ++i)
+    {
+      const Vec3 p = unitMesh.Points[i] / voxelSize;
+      points[i] = openvdb::Vec3s(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
+    }
+    order = mortonOrder(points, unitMesh.Triangles);
+    tris.resize(order.size());
+    for (std::size_t f = 0; f < tris.size(); ++f)
+    {
+      const Triangle& t = unitMesh.Triangles[order[f]];
+      tris[f] = openvdb::Vec3I(t[0], t[1], t[2]);
+    }
+  }
+  const CancellableMeshAdapter adapter(points, tris, progress, &expanding);
   try
   {
     if (ownBand)
