@@ -342,32 +342,29 @@ std::vector<int> sampleSurface(
   return samples;
 }
 
-/// Centres of the certificate balls: the first sample (in point order) of every occupied cell of
-/// side reach / sqrt(3), so every sample lies within `reach` of the centre of its cell.
+/// Centres of the certificate balls: a greedy cover, every sample within `reach` of a centre, the
+/// centres farther than `reach` apart (samples in point order; a sample not yet covered becomes a
+/// centre). A centre per occupied grid cell of side reach / sqrt(3) covered the same but needed
+/// 3.2 times as many (dragon_vrip: 8,668 centres, 1.1 s of its 1.6 s of active points). Which
+/// samples the balls certify does not change the active set, only how cheaply it is found.
 std::vector<int> ballCentres(const std::vector<Vec3>& points, const std::vector<int>& samples, double reach)
 {
   std::vector<int> centres;
-  if (!(reach > 0))
+  if (!(reach > 0) || samples.empty())
   {
     return centres;
   }
-  const double cell = reach / std::sqrt(3.0);
-  std::vector<std::pair<std::array<std::int64_t, 3>, int>> keyed(samples.size());
-  for (std::size_t k = 0; k < samples.size(); ++k)
+  const PointGrid grid(points, samples, reach);
+  std::vector<char> covered(points.size(), 0);
+  for (int p : samples)
   {
-    const Vec3& x = points[samples[k]];
-    keyed[k] = { { static_cast<std::int64_t>(std::floor(x.x() / cell)),
-                   static_cast<std::int64_t>(std::floor(x.y() / cell)),
-                   static_cast<std::int64_t>(std::floor(x.z() / cell)) },
-      samples[k] };
-  }
-  std::sort(keyed.begin(), keyed.end());
-  for (std::size_t k = 0; k < keyed.size(); ++k)
-  {
-    if (k == 0 || keyed[k].first != keyed[k - 1].first)
+    if (covered[p])
     {
-      centres.push_back(keyed[k].second);
+      continue;
     }
+    centres.push_back(p);
+    grid.forEachWithin(points[p], reach, [&](int q) { covered[q] = 1; });
+    covered[p] = 1;
   }
   return centres;
 }
