@@ -5,6 +5,8 @@
 
 #include "Common/Progress.h"
 
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cstddef>
 #include <vector>
@@ -13,36 +15,40 @@ namespace sdfcage
 {
 
 /// Sorts `v` by `less` like std::sort (the same order, but for equivalent elements), in chunks of
-/// `chunk` elements merged pairwise, with a cancel check before every chunk and every merge.
-/// Returns false, `v` then in no particular order, once `progress` is cancelled. Without
-/// `progress`, or for a short vector, it is std::sort.
+/// `chunk` elements merged pairwise, with a cancel check before every chunk and every merge. The
+/// chunks, and the merges of one width, run in parallel (TBB): the order is the same for any
+/// number of threads. Returns false, `v` then in no particular order, once `progress` is
+/// cancelled. A vector of at most `chunk` elements is std::sort.
 template <typename T, typename Less>
 bool cancellableSort(std::vector<T>& v, Less less, Progress* progress, std::size_t chunk = std::size_t(1) << 16)
 {
   const std::size_t n = v.size();
-  if (!progress || n <= chunk)
+  if (n <= chunk)
   {
     std::sort(v.begin(), v.end(), less);
     return !progressCancelled(progress);
   }
   using Diff = typename std::vector<T>::difference_type;
   const auto at = [&v](std::size_t i) { return v.begin() + static_cast<Diff>(i); };
-  for (std::size_t b = 0; b < n; b += chunk)
-  {
-    if (progress->cancelled())
-      return false;
-    std::sort(at(b), at(std::min(n, b + chunk)), less);
-  }
+  const std::size_t chunks = (n + chunk - 1) / chunk;
+  tbb::parallel_for(std::size_t(0), chunks, [&](std::size_t c) {
+    if (progressCancelled(progress))
+      return;
+    std::sort(at(c * chunk), at(std::min(n, (c + 1) * chunk)), less);
+  });
   for (std::size_t width = chunk; width < n; width *= 2)
   {
-    for (std::size_t b = 0; b + width < n; b += 2 * width)
-    {
-      if (progress->cancelled())
-        return false;
+    if (progressCancelled(progress))
+      return false;
+    const std::size_t pairs = (n - width + 2 * width - 1) / (2 * width); // b = 2 k width with b + width < n
+    tbb::parallel_for(std::size_t(0), pairs, [&](std::size_t k) {
+      const std::size_t b = 2 * k * width;
+      if (progressCancelled(progress))
+        return;
       std::inplace_merge(at(b), at(b + width), at(std::min(n, b + 2 * width)), less);
-    }
+    });
   }
-  return !progress->cancelled();
+  return !progressCancelled(progress);
 }
 
 template <typename T>
