@@ -483,8 +483,13 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
   // A cancel cuts the build short (every return path waits for it); tree() then builds it
   // again in full, should anything still ask for it.
   std::atomic<bool> treeComplete{ false };
-  treeTask.run([&unitInput, inputTree, winding, progress, &treeComplete] {
-    if (!inputTree->build(unitInput, progress))
+  // Inputs without a defined topology (soups) enter their long triangles as pieces: a soup of
+  // long slivers otherwise has every box overlap every query (20,000 random slivers: 74 s, most of
+  // it in the simplifier's and the winding number's queries). Closed inputs keep whole triangles
+  // and so exactly today's cages (pieces change which of two equidistant triangles a query names).
+  const bool splitLong = !flood;
+  treeTask.run([&unitInput, inputTree, winding, splitLong, progress, &treeComplete] {
+    if (!inputTree->build(unitInput, progress, splitLong))
     {
       return;
     }
@@ -515,7 +520,7 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
       treeTask.wait();
       if (!treeComplete.load())
       {
-        inputTree->build(unitInput);
+        inputTree->build(unitInput, nullptr, splitLong);
         if (winding)
         {
           inputTree->prepareWindingNumbers();

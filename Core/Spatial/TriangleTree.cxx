@@ -29,16 +29,68 @@ int subtreeNodes(int count, int depth)
 }
 } // namespace
 
+// Long triangles entered as pieces (build's splitLong): no piece edge longer than 1/32 of the
+// mesh's bounding-box diagonal, by longest-edge bisection. At most as many extra pieces as
+// triangles or 2^19, whichever is more (the length doubles until they fit): 20,000 random slivers
+// across the unit sphere become some 300,000 entries, 60 MB. No library offers this: it is the
+// tree's own leaf layout.
+namespace
+{
+constexpr double SplitFraction = 1.0 / 32.0;
+constexpr int SplitDepth = 20;
+
+template <typename Emit>
+void splitTriangle(const Vec3& a, const Vec3& b, const Vec3& c, double length2, int depth, Emit& emit)
+{
+  const double ab = (b - a).squaredNorm(), bc = (c - b).squaredNorm(), ca = (a - c).squaredNorm();
+  const double m = std::max({ ab, bc, ca });
+  if (m <= length2 || depth >= SplitDepth)
+  {
+    emit(a, b, c);
+    return;
+  }
+  // the halves keep the triangle's orientation
+  if (m == ab)
+  {
+    const Vec3 h = 0.5 * (a + b);
+    splitTriangle(a, h, c, length2, depth + 1, emit);
+    splitTriangle(h, b, c, length2, depth + 1, emit);
+  }
+  else if (m == bc)
+  {
+    const Vec3 h = 0.5 * (b + c);
+    splitTriangle(a, b, h, length2, depth + 1, emit);
+    splitTriangle(a, h, c, length2, depth + 1, emit);
+  }
+  else
+  {
+    const Vec3 h = 0.5 * (c + a);
+    splitTriangle(a, b, h, length2, depth + 1, emit);
+    splitTriangle(h, b, c, length2, depth + 1, emit);
+  }
+}
+
+std::size_t pieceCount(const Vec3& a, const Vec3& b, const Vec3& c, double length2)
+{
+  std::size_t count = 0;
+  auto emit = [&count](const Vec3&, const Vec3&, const Vec3&) { ++count; };
+  splitTriangle(a, b, c, length2, 0, emit);
+  return count;
+}
+} // namespace
+
 void TriangleTree::build(const TriangleMesh& mesh)
 {
   this->build(mesh, nullptr);
 }
 
-bool TriangleTree::build(const TriangleMesh& mesh, Progress* progress)
+bool TriangleTree::build(const TriangleMesh& mesh, Progress* progress, bool splitLong)
 {
   Nodes.clear();
   Dipoles.clear();
   Tri.clear();
+  Pieces.clear();
+  SplitTriangles = 0;
   Normals.clear();
   const std::size_t n = mesh.Triangles.size();
   if (n == 0)
@@ -47,7 +99,6 @@ bool TriangleTree::build(const TriangleMesh& mesh, Progress* progress)
   }
   std::vector<Tri3> tri(n);
   Normals.resize(n);
-  std::vector<Vec3> centroids(n);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
     if (progressCancelled(progress))
       return;
@@ -61,37 +112,123 @@ bool TriangleTree::build(const TriangleMesh& mesh, Progress* progress)
       tri[f].Id = static_cast<int>(f);
       const Vec3 nrm = (tri[f].P[1] - tri[f].P[0]).cross(tri[f].P[2] - tri[f].P[0]);
       Normals[f] = nrm.norm() > 0 ? Vec3(nrm.normalized()) : Vec3(Vec3::Zero());
-      centroids[f] = (tri[f].P[0] + tri[f].P[1] + tri[f].P[2]) / 3.0;
     }
   });
+  // the pieces of long triangles: counted first (the length grows until they fit), then made
+  std::vector<std::size_t> first; // entries of triangle f: [first[f], first[f + 1])
+  double length2 = 0.0;
+  if (splitLong && !progressCancelled(progress))
+  {
+    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+    for (const Tri3& t : tri)
+      for (const Vec3& q : t.P)
+      {
+        lo = lo.cwiseMin(q);
+        hi = hi.cwiseMax(q);
+      }
+    const double length = SplitFraction * (hi - lo).norm();
+    length2 = length * length;
+    const std::size_t extraCap = std::max<std::size_t>(n, std::size_t(1) << 19);
+    first.assign(n + 1, 0);
+    for (int round = 0; round < 64 && length2 > 0 && std::isfinite(length2); ++round, length2 *= 4.0)
+    {
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t f = r.begin(); f != r.end(); ++f)
+          first[f + 1] = pieceCount(tri[f].P[0], tri[f].P[1], tri[f].P[2], length2);
+      });
+      first[0] = 0;
+      for (std::size_t f = 0; f < n; ++f)
+        first[f + 1] += first[f];
+      if (first[n] - n <= extraCap)
+        break;
+    }
+    if (!(length2 > 0) || !std::isfinite(length2) || first[n] - n > extraCap || first[n] == n)
+    {
+      first.clear(); // nothing long (or nothing sensible): whole triangles
+    }
+  }
+  const std::size_t m = first.empty() ? n : first[n];
+  std::vector<Tri3> entries;
+  std::vector<Piece> pieces;
+  std::vector<BuildItem> items(m);
+  if (first.empty())
+  {
+    entries = std::move(tri);
+    for (std::size_t f = 0; f < n; ++f)
+    {
+      items[f] = { (entries[f].P[0] + entries[f].P[1] + entries[f].P[2]) / 3.0, static_cast<int>(f) };
+    }
+  }
+  else
+  {
+    entries.resize(m);
+    pieces.resize(m);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+      if (progressCancelled(progress))
+        return;
+      for (std::size_t f = r.begin(); f != r.end(); ++f)
+      {
+        const Vec3* P = tri[f].P;
+        const double pad = 1e-9 * std::sqrt(std::max(
+          { (P[1] - P[0]).squaredNorm(), (P[2] - P[1]).squaredNorm(), (P[0] - P[2]).squaredNorm() }));
+        std::size_t e = first[f];
+        auto emit = [&](const Vec3& a, const Vec3& b, const Vec3& c) {
+          entries[e] = tri[f];
+          Piece& q = pieces[e];
+          q.P[0] = a;
+          q.P[1] = b;
+          q.P[2] = c;
+          q.Lo = a.cwiseMin(b).cwiseMin(c) - Vec3::Constant(pad);
+          q.Hi = a.cwiseMax(b).cwiseMax(c) + Vec3::Constant(pad);
+          items[e] = { (a + b + c) / 3.0, static_cast<int>(e) };
+          ++e;
+        };
+        splitTriangle(P[0], P[1], P[2], length2, 0, emit);
+      }
+    });
+    for (std::size_t f = 0; f < n; ++f)
+    {
+      SplitTriangles += first[f + 1] - first[f] > 1 ? 1 : 0;
+    }
+  }
+  if (m > static_cast<std::size_t>(std::numeric_limits<int>::max() / 4))
+  {
+    Nodes.clear();
+    Normals.clear();
+    return false; // beyond the int indices (the memory budget stops inputs long before)
+  }
   // The node layout is fixed in advance (pre-order, sizes known from the counts), so subtrees
   // are built in parallel into their own ranges and the tree does not depend on the threads.
-  Nodes.resize(static_cast<std::size_t>(subtreeNodes(static_cast<int>(n), 0)));
-  std::vector<BuildItem> items(n);
-  for (std::size_t f = 0; f < n; ++f)
-  {
-    items[f] = { centroids[f], static_cast<int>(f) };
-  }
+  Nodes.resize(static_cast<std::size_t>(subtreeNodes(static_cast<int>(m), 0)));
   if (!progressCancelled(progress))
   {
-    buildNode(0, 0, static_cast<int>(n), items, tri, 0, progress);
+    buildNode(0, 0, static_cast<int>(m), items, entries, pieces, 0, progress);
   }
   if (progressCancelled(progress))
   {
     Nodes.clear(); // some subtrees were skipped: nothing of it may be used
     Normals.clear();
+    SplitTriangles = 0;
     return false;
   }
-  Tri.resize(n);
-  for (std::size_t i = 0; i < n; ++i)
+  Tri.resize(m);
+  for (std::size_t i = 0; i < m; ++i)
   {
-    Tri[i] = tri[items[i].Id];
+    Tri[i] = entries[items[i].Id];
+  }
+  if (!pieces.empty())
+  {
+    Pieces.resize(m);
+    for (std::size_t i = 0; i < m; ++i)
+    {
+      Pieces[i] = pieces[items[i].Id];
+    }
   }
   return true;
 }
 
 void TriangleTree::buildNode(int index, int start, int count, std::vector<BuildItem>& items,
-  const std::vector<Tri3>& tri, int depth, Progress* progress)
+  const std::vector<Tri3>& tri, const std::vector<Piece>& pieces, int depth, Progress* progress)
 {
   if (count > 8192 && progressCancelled(progress))
   {
@@ -103,6 +240,12 @@ void TriangleTree::buildNode(int index, int start, int count, std::vector<BuildI
     Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
     for (int i = start; i < start + count; ++i)
     {
+      if (!pieces.empty())
+      {
+        lo = lo.cwiseMin(pieces[items[i].Id].Lo);
+        hi = hi.cwiseMax(pieces[items[i].Id].Hi);
+        continue;
+      }
       for (const Vec3& p : tri[items[i].Id].P)
       {
         lo = lo.cwiseMin(p);
@@ -134,8 +277,8 @@ void TriangleTree::buildNode(int index, int start, int count, std::vector<BuildI
   const int right = left + subtreeNodes(half, depth + 1);
   node.Left = left;
   node.Right = right;
-  auto buildLeft = [&] { buildNode(left, start, half, items, tri, depth + 1, progress); };
-  auto buildRight = [&] { buildNode(right, start + half, count - half, items, tri, depth + 1, progress); };
+  auto buildLeft = [&] { buildNode(left, start, half, items, tri, pieces, depth + 1, progress); };
+  auto buildRight = [&] { buildNode(right, start + half, count - half, items, tri, pieces, depth + 1, progress); };
   if (count > 8192)
   {
     tbb::parallel_invoke(buildLeft, buildRight);
@@ -195,8 +338,11 @@ bool TriangleTree::closestPoint(const Vec3& p, double maxDistance, Vec3& closest
       {
         const Vec3* P = Tri[i].P;
         // the triangle's own box first: nothing in it is nearer than the box (the margin keeps
-        // rounding in the closest point from ever making this skip a triangle it would take)
-        const Vec3 lo = P[0].cwiseMin(P[1]).cwiseMin(P[2]), hi = P[0].cwiseMax(P[1]).cwiseMax(P[2]);
+        // rounding in the closest point from ever making this skip a triangle it would take). A
+        // piece's box: the piece holding the triangle's closest point is not skipped.
+        const bool piece = !Pieces.empty();
+        const Vec3 lo = piece ? Pieces[i].Lo : Vec3(P[0].cwiseMin(P[1]).cwiseMin(P[2]));
+        const Vec3 hi = piece ? Pieces[i].Hi : Vec3(P[0].cwiseMax(P[1]).cwiseMax(P[2]));
         if (boxPointDistance2(lo, hi, p) > best2 * (1.0 + 1e-9))
         {
           continue;
@@ -315,6 +461,11 @@ double TriangleTree::triangleQuery(const Vec3 t[3], double limit, bool stopAtFir
     for (int i = n.Start; i < n.Start + n.Count; ++i)
     {
       const Tri3& o = Tri[i];
+      // a piece whose box is beyond the limit: the triangle's nearest point lies in another piece
+      if (!Pieces.empty() && boxBoxDistance2(Pieces[i].Lo, Pieces[i].Hi, tlo, thi) >= best * best)
+      {
+        continue;
+      }
       if (hasPlane)
       {
         const double s0 = normal.dot(o.P[0]) - offset, s1 = normal.dot(o.P[1]) - offset,
@@ -375,6 +526,7 @@ long long TriangleTree::countWithin(const Vec3 t[3], double delta) const
   const Vec3 tlo = t[0].cwiseMin(t[1]).cwiseMin(t[2]);
   const Vec3 thi = t[0].cwiseMax(t[1]).cwiseMax(t[2]);
   long long count = 0;
+  std::vector<int> ids; // with pieces: a triangle counts once
   int stack[128];
   int top = 0;
   stack[top++] = 0;
@@ -393,16 +545,40 @@ long long TriangleTree::countWithin(const Vec3 t[3], double delta) const
     }
     for (int i = n.Start; i < n.Start + n.Count; ++i)
     {
+      if (!Pieces.empty() && boxBoxDistance2(Pieces[i].Lo, Pieces[i].Hi, tlo, thi) > delta * delta)
+      {
+        continue;
+      }
       const double d2 = triangleTriangleDistance2(t, Tri[i].P);
-      count += (d2 == 0.0 || d2 <= delta * delta) ? 1 : 0;
+      if (d2 == 0.0 || d2 <= delta * delta)
+      {
+        ++count;
+        if (!Pieces.empty())
+        {
+          ids.push_back(Tri[i].Id);
+        }
+      }
     }
+  }
+  if (!Pieces.empty())
+  {
+    std::sort(ids.begin(), ids.end());
+    count = static_cast<long long>(std::unique(ids.begin(), ids.end()) - ids.begin());
   }
   return count;
 }
 
 void TriangleTree::trianglesWithin(const Vec3 t[3], double radius, std::vector<int>& ids) const
 {
+  const std::size_t before = ids.size();
   this->triangleQuery(t, radius, false, &ids);
+  if (!Pieces.empty())
+  {
+    // a triangle found through several of its pieces is listed once
+    const auto begin = ids.begin() + static_cast<std::ptrdiff_t>(before);
+    std::sort(begin, ids.end());
+    ids.erase(std::unique(begin, ids.end()), ids.end());
+  }
 }
 
 void TriangleTree::prepareWindingNumbers()
@@ -424,7 +600,7 @@ void TriangleTree::prepareWindingNumbers()
         Vec3 mean = Vec3::Zero();
         for (int k = node.Start; k < node.Start + node.Count; ++k)
         {
-          const Vec3* P = Tri[k].P;
+          const Vec3* P = this->windingCorners(k);
           const Vec3 an = 0.5 * (P[1] - P[0]).cross(P[2] - P[0]);
           const double a = an.norm();
           d.AreaNormal += an;
@@ -435,7 +611,8 @@ void TriangleTree::prepareWindingNumbers()
         d.Center = d.Area > 0 ? Vec3(weighted / d.Area) : Vec3(mean / std::max(1, node.Count));
         for (int k = node.Start; k < node.Start + node.Count; ++k)
         {
-          for (const Vec3& q : Tri[k].P)
+          const Vec3* Q = this->windingCorners(k);
+          for (const Vec3& q : { Q[0], Q[1], Q[2] })
           {
             d.Radius = std::max(d.Radius, (q - d.Center).norm());
           }
@@ -485,7 +662,8 @@ double TriangleTree::windingNumber(const Vec3& p, double beta) const
     {
       for (int k = node.Start; k < node.Start + node.Count; ++k)
       {
-        total += solidAngle(Tri[k].P[0], Tri[k].P[1], Tri[k].P[2], p); // exact
+        const Vec3* P = this->windingCorners(k);
+        total += solidAngle(P[0], P[1], P[2], p); // exact
       }
       continue;
     }

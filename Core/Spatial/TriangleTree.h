@@ -16,11 +16,14 @@ class TriangleTree
 {
 public:
   TriangleTree() = default;
-  explicit TriangleTree(const TriangleMesh& mesh) { this->build(mesh); }
+  explicit TriangleTree(const TriangleMesh& mesh, bool splitLong = false) { this->build(mesh, nullptr, splitLong); }
   void build(const TriangleMesh& mesh);
   /// The same with cancel checks (about every 8,000 triangles): false, and an empty tree, once
-  /// `progress` is cancelled.
-  bool build(const TriangleMesh& mesh, Progress* progress);
+  /// `progress` is cancelled. `splitLong`: triangles longer than 1/32 of the mesh's diagonal are
+  /// entered as pieces (see SplitLength in the .cxx): a soup of long slivers, whose boxes all
+  /// overlap, then gets boxes that prune. Every query's answer is the same up to ties (distances
+  /// are still measured to the whole triangles; winding numbers sum the pieces).
+  bool build(const TriangleMesh& mesh, Progress* progress, bool splitLong = false);
 
   /// Closest point on the mesh to p within maxDistance (<0: unlimited). False when none.
   bool closestPoint(const Vec3& p, double maxDistance, Vec3& closest, int& triangle, double& distance) const;
@@ -52,7 +55,10 @@ public:
   bool windingNumbersReady() const { return !Dipoles.empty() || Nodes.empty(); }
 
   bool empty() const { return Nodes.empty(); }
+  /// Entries in the tree: the triangles, or more when long ones were entered as pieces.
   std::size_t size() const { return Tri.size(); }
+  /// Triangles entered as more than one piece (build's `splitLong`).
+  std::size_t splitTriangles() const { return SplitTriangles; }
 
 private:
   struct Node
@@ -65,8 +71,13 @@ private:
   };
   struct Tri3
   {
-    Vec3 P[3];
+    Vec3 P[3]; // the whole triangle (every distance is measured to it)
     int Id;
+  };
+  struct Piece
+  {
+    Vec3 P[3];      // the piece of the triangle this entry stands for (winding numbers)
+    Vec3 Lo, Hi;    // its box, padded so that the pieces' boxes cover the whole triangle
   };
   struct BuildItem
   {
@@ -74,7 +85,8 @@ private:
     int Id;
   };
   void buildNode(int index, int start, int count, std::vector<BuildItem>& items, const std::vector<Tri3>& tri,
-    int depth, Progress* progress);
+    const std::vector<Piece>& pieces, int depth, Progress* progress);
+  const Vec3* windingCorners(int entry) const { return Pieces.empty() ? Tri[entry].P : Pieces[entry].P; }
   double triangleQuery(const Vec3 t[3], double limit, bool stopAtFirst, std::vector<int>* within = nullptr) const;
   struct Dipole
   {
@@ -86,6 +98,8 @@ private:
   std::vector<Node> Nodes;
   std::vector<Dipole> Dipoles;
   std::vector<Tri3> Tri;
+  std::vector<Piece> Pieces; // parallel to Tri when some triangle was split, else empty
+  std::size_t SplitTriangles = 0;
   std::vector<Vec3> Normals;
 };
 

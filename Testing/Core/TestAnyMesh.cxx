@@ -17,6 +17,8 @@
 #include <cmath>
 #include <functional>
 #include <iostream>
+#include <limits>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -573,6 +575,72 @@ TEST(AnyMeshRepairs, WindingNumberOfTheTreeMatchesTheExactSum)
   EXPECT_NEAR(st.windingNumber(Vec3(0.5, 0.5, 0.01)), -0.5, 0.05);
   EXPECT_NEAR(st.windingNumber(Vec3(0.5, 0.5, -0.01)), 0.5, 0.05);
   EXPECT_LT(std::abs(st.windingNumber(Vec3(0.5, 0.5, 0.3))), 0.5);
+}
+
+TEST(AnyMeshRepairs, LongTrianglesEnteredAsPiecesAnswerAsWholeTriangles)
+{
+  // 300 random slivers across the unit ball (each as long as the ball is wide) and a small sphere:
+  // the tree with pieces answers every query as the tree of whole triangles and as brute force
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  auto inBall = [&]() {
+    for (;;)
+    {
+      const Vec3 p(u(rng), u(rng), u(rng));
+      if (p.squaredNorm() <= 1.0)
+        return p;
+    }
+  };
+  TriangleMesh m = makeSphere(Vec3(0.2, 0.1, 0), 0.2, 12, 6);
+  for (int i = 0; i < 300; ++i)
+  {
+    const Vec3 a = inBall(), b = inBall();
+    const Vec3 c = 0.5 * (a + b) + 1e-3 * Vec3(u(rng), u(rng), u(rng));
+    const int base = static_cast<int>(m.Points.size());
+    m.Points.insert(m.Points.end(), { a, b, c });
+    m.Triangles.push_back({ base, base + 1, base + 2 });
+  }
+  TriangleTree whole(m), pieces;
+  ASSERT_TRUE(pieces.build(m, nullptr, true));
+  EXPECT_EQ(whole.size(), m.Triangles.size());
+  EXPECT_EQ(whole.splitTriangles(), 0u);
+  EXPECT_GT(pieces.splitTriangles(), 250u);
+  EXPECT_GT(pieces.size(), 4 * m.Triangles.size());
+  whole.prepareWindingNumbers();
+  pieces.prepareWindingNumbers();
+  for (int q = 0; q < 300; ++q)
+  {
+    const Vec3 p = 1.2 * inBall();
+    double brute = std::numeric_limits<double>::infinity();
+    for (const Triangle& t : m.Triangles)
+      brute = std::min(brute, (closestPointOnTriangle(p, m.Points[t[0]], m.Points[t[1]], m.Points[t[2]]) - p).norm());
+    Vec3 c;
+    int tri = -1;
+    double d = -1;
+    ASSERT_TRUE(pieces.closestPoint(p, -1.0, c, tri, d));
+    EXPECT_EQ(d, whole.distance(p)) << p.transpose();
+    EXPECT_EQ(d, brute) << p.transpose();
+    EXPECT_NEAR((closestPointOnTriangle(p, m.Points[m.Triangles[tri][0]], m.Points[m.Triangles[tri][1]],
+                   m.Points[m.Triangles[tri][2]]) - p).norm(), d, 1e-15);
+    // bounded: none within a tenth of the distance
+    EXPECT_FALSE(pieces.closestPoint(p, 0.1 * d, c, tri, d));
+    // winding numbers: the pieces' dipoles and exact sums against the exact sum over the triangles
+    const double exact = sdfcage::windingNumber(m, p);
+    EXPECT_NEAR(pieces.windingNumber(p), exact, 0.05) << p.transpose();
+    // triangle queries
+    const Vec3 t[3] = { p, p + 0.3 * Vec3(u(rng), u(rng), u(rng)), p + 0.3 * Vec3(u(rng), u(rng), u(rng)) };
+    for (double limit : { 0.01, 0.05, 0.2 })
+    {
+      EXPECT_EQ(pieces.triangleDistance(t, limit), whole.triangleDistance(t, limit));
+      EXPECT_EQ(pieces.anyCloserThan(t, limit), whole.anyCloserThan(t, limit));
+      EXPECT_EQ(pieces.countWithin(t, limit), whole.countWithin(t, limit));
+      std::vector<int> a{ -7 }, b{ -7 }; // appended after what is there
+      pieces.trianglesWithin(t, limit, a);
+      whole.trianglesWithin(t, limit, b);
+      std::sort(b.begin() + 1, b.end());
+      EXPECT_EQ(a, b);
+    }
+  }
 }
 
 TEST(AnyMeshRepairs, ForcedRulesAreHonoured)
