@@ -38,9 +38,10 @@ def load_plugin(path, ns):
 
 
 def open_surface(path):
-    """MESH as polydata: .off through the plugin's reader, anything else through ParaView's own
-    readers, then Extract Surface. None (with a message) when ParaView cannot open it."""
-    reader = simple.OFFMeshReader(FileName=path) if path.lower().endswith(".off") else simple.OpenDataFile(path)
+    """MESH as polydata: through ParaView's readers (.off through the plugin's, which registers its
+    extension: LoadPlugin puts the plugin's functions into the script's namespace, not into
+    paraview.simple), then Extract Surface. None (with a message) when ParaView cannot open it."""
+    reader = simple.OpenDataFile(path)
     if reader is None:
         print("error: cannot open %s" % path)
         return None
