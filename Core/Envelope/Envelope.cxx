@@ -487,7 +487,14 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
   // long slivers otherwise has every box overlap every query (20,000 random slivers: 74 s, most of
   // it in the simplifier's and the winding number's queries). Closed inputs keep whole triangles
   // and so exactly today's cages (pieces change which of two equidistant triangles a query names).
-  const bool splitLong = !flood;
+  // Their memory counts in the budget (the grids' checks below add it); pieces that would take more
+  // than a quarter of it are not made (whole triangles: slower, never wrong).
+  std::size_t pieceBytes = flood ? 0 : TriangleTree::pieceBytes(unitInput);
+  if (pieceBytes > options.memoryLimit() / 4)
+  {
+    pieceBytes = 0;
+  }
+  const bool splitLong = !flood && pieceBytes > 0;
   treeTask.run([&unitInput, inputTree, winding, splitLong, progress, &treeComplete] {
     if (!inputTree->build(unitInput, progress, splitLong))
     {
@@ -594,7 +601,7 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
     const bool coarseLevel = level < 0;
     bool coarseRejected = false;
     // the memory budget, before the grid is built (MemoryBudget.h)
-    const std::size_t need = estimateEnvelopeBytes(unitInput, h, c, flood, options.KeepDistanceField);
+    const std::size_t need = estimateEnvelopeBytes(unitInput, h, c, flood, options.KeepDistanceField) + pieceBytes;
     if (need > options.memoryLimit() && coarseLevel)
     {
       continue; // the requested grid, finer, is over it too: its check names the need

@@ -79,6 +79,60 @@ std::size_t pieceCount(const Vec3& a, const Vec3& b, const Vec3& c, double lengt
 }
 } // namespace
 
+double TriangleTree::pieceLayout(const TriangleMesh& mesh, std::vector<std::size_t>& first)
+{
+  first.clear();
+  const std::size_t n = mesh.Triangles.size();
+  if (n == 0)
+  {
+    return 0.0;
+  }
+  Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
+  for (const Triangle& t : mesh.Triangles)
+    for (int k = 0; k < 3; ++k)
+    {
+      lo = lo.cwiseMin(mesh.Points[t[k]]);
+      hi = hi.cwiseMax(mesh.Points[t[k]]);
+    }
+  const double length = SplitFraction * (hi - lo).norm();
+  double length2 = length * length;
+  const std::size_t extraCap = std::max<std::size_t>(n, std::size_t(1) << 19);
+  first.assign(n + 1, 0);
+  for (int round = 0; round < 64 && length2 > 0 && std::isfinite(length2); ++round, length2 *= 4.0)
+  {
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t f = r.begin(); f != r.end(); ++f)
+      {
+        const Triangle& t = mesh.Triangles[f];
+        first[f + 1] = pieceCount(mesh.Points[t[0]], mesh.Points[t[1]], mesh.Points[t[2]], length2);
+      }
+    });
+    first[0] = 0;
+    for (std::size_t f = 0; f < n; ++f)
+      first[f + 1] += first[f];
+    if (first[n] - n <= extraCap)
+      break;
+  }
+  if (!(length2 > 0) || !std::isfinite(length2) || first[n] - n > extraCap || first[n] == n)
+  {
+    first.clear(); // nothing long (or nothing sensible): whole triangles
+    return 0.0;
+  }
+  return length2;
+}
+
+std::size_t TriangleTree::pieceBytes(const TriangleMesh& mesh)
+{
+  std::vector<std::size_t> first;
+  if (!(pieceLayout(mesh, first) > 0.0))
+  {
+    return 0;
+  }
+  const std::size_t extra = first.back() - mesh.Triangles.size();
+  // per entry: the whole triangle, the piece, the build item; the node count grows with the entries
+  return extra * (sizeof(Tri3) + sizeof(Piece) + sizeof(BuildItem) + sizeof(Node) / 2);
+}
+
 void TriangleTree::build(const TriangleMesh& mesh)
 {
   this->build(mesh, nullptr);
@@ -116,37 +170,7 @@ bool TriangleTree::build(const TriangleMesh& mesh, Progress* progress, bool spli
   });
   // the pieces of long triangles: counted first (the length grows until they fit), then made
   std::vector<std::size_t> first; // entries of triangle f: [first[f], first[f + 1])
-  double length2 = 0.0;
-  if (splitLong && !progressCancelled(progress))
-  {
-    Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
-    for (const Tri3& t : tri)
-      for (const Vec3& q : t.P)
-      {
-        lo = lo.cwiseMin(q);
-        hi = hi.cwiseMax(q);
-      }
-    const double length = SplitFraction * (hi - lo).norm();
-    length2 = length * length;
-    const std::size_t extraCap = std::max<std::size_t>(n, std::size_t(1) << 19);
-    first.assign(n + 1, 0);
-    for (int round = 0; round < 64 && length2 > 0 && std::isfinite(length2); ++round, length2 *= 4.0)
-    {
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 1024), [&](const tbb::blocked_range<std::size_t>& r) {
-        for (std::size_t f = r.begin(); f != r.end(); ++f)
-          first[f + 1] = pieceCount(tri[f].P[0], tri[f].P[1], tri[f].P[2], length2);
-      });
-      first[0] = 0;
-      for (std::size_t f = 0; f < n; ++f)
-        first[f + 1] += first[f];
-      if (first[n] - n <= extraCap)
-        break;
-    }
-    if (!(length2 > 0) || !std::isfinite(length2) || first[n] - n > extraCap || first[n] == n)
-    {
-      first.clear(); // nothing long (or nothing sensible): whole triangles
-    }
-  }
+  const double length2 = splitLong && !progressCancelled(progress) ? pieceLayout(mesh, first) : 0.0;
   const std::size_t m = first.empty() ? n : first[n];
   std::vector<Tri3> entries;
   std::vector<Piece> pieces;

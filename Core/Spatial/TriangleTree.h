@@ -59,6 +59,9 @@ public:
   std::size_t size() const { return Tri.size(); }
   /// Triangles entered as more than one piece (build's `splitLong`).
   std::size_t splitTriangles() const { return SplitTriangles; }
+  /// Memory the pieces of build(mesh, ..., true) take beyond a tree of whole triangles (0 when no
+  /// triangle is long), for the memory budget before the tree is built.
+  static std::size_t pieceBytes(const TriangleMesh& mesh);
 
 private:
   struct Node
@@ -86,6 +89,9 @@ private:
   };
   void buildNode(int index, int start, int count, std::vector<BuildItem>& items, const std::vector<Tri3>& tri,
     const std::vector<Piece>& pieces, int depth, Progress* progress);
+  // Entries per triangle (first[f] .. first[f + 1]) and the squared piece length; 0 and no
+  // entries when no triangle is split.
+  static double pieceLayout(const TriangleMesh& mesh, std::vector<std::size_t>& first);
   const Vec3* windingCorners(int entry) const { return Pieces.empty() ? Tri[entry].P : Pieces[entry].P; }
   double triangleQuery(const Vec3 t[3], double limit, bool stopAtFirst, std::vector<int>* within = nullptr) const;
   struct Dipole

@@ -606,6 +606,11 @@ TEST(AnyMeshRepairs, LongTrianglesEnteredAsPiecesAnswerAsWholeTriangles)
   EXPECT_EQ(whole.splitTriangles(), 0u);
   EXPECT_GT(pieces.splitTriangles(), 250u);
   EXPECT_GT(pieces.size(), 4 * m.Triangles.size());
+  // the budget's figure: the extra entries' memory, none for a mesh without long triangles
+  EXPECT_GE(TriangleTree::pieceBytes(m), (pieces.size() - m.Triangles.size()) * 100);
+  EXPECT_LE(TriangleTree::pieceBytes(m), (pieces.size() - m.Triangles.size()) * 1000);
+  EXPECT_EQ(TriangleTree::pieceBytes(makeSphere(Vec3(0, 0, 0), 1.0, 128, 64)), 0u); // edges below 1/32 of 3.46
+  EXPECT_GT(TriangleTree::pieceBytes(makeSphere(Vec3(0, 0, 0), 1.0, 24, 12)), 0u);   // edges of 0.26
   whole.prepareWindingNumbers();
   pieces.prepareWindingNumbers();
   for (int q = 0; q < 300; ++q)
