@@ -17,7 +17,6 @@
 #include <vtkPLYWriter.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
-#include <vtkPolyDataReader.h>
 #include <vtkPolyDataWriter.h>
 #include <vtkSTLReader.h>
 #include <vtkSTLWriter.h>
@@ -151,332 +150,6 @@ bool checkXMLComponents(const std::string& bytes, std::string& why)
         }
       }
       open = bytes.find(section.Open, close);
-    }
-  }
-  return true;
-}
-
-/// Legacy VTK cell lists before file version 5 ("POLYGONS n size" followed by `size` values,
-/// each cell its point count and then its points): vtkPolyDataReader reads the `size` values and
-/// then walks them cell by cell trusting every count, so a count larger than what is left of the
-/// section made it read past its buffer (a fuzzed file crashed it). Walk the section here first:
-/// every cell must fit in it. `start` is where the values begin (the line after the header);
-/// sections VTK cannot read at all (too short, not numbers) are left for VTK to refuse. Files of
-/// version 5 and later (an OFFSETS line follows): checkLegacyCellsV5.
-/// Version 5 and later ("POLYGONS n size", then "OFFSETS type" with n offsets and "CONNECTIVITY
-/// type" with `size` point ids): vtkPolyDataReader trusts the offsets, so a damaged list (a
-/// fuzzed file: offsets cut short by bytes that are no numbers) made it read past its buffer.
-/// Both lists must be there in full, the offsets start at 0, never decrease and end at `size`.
-bool checkLegacyCellsV5(const std::string& bytes, std::size_t at, bool binary, double declaredOffsets,
-  double declaredValues, const std::string& keyword, int lineNumber, std::string& why)
-{
-  const auto n = static_cast<std::size_t>(declaredOffsets); // both fit: checked against the file size
-  const auto values = static_cast<std::size_t>(declaredValues);
-  auto refuse = [&](const std::string& what) {
-    why = "line " + std::to_string(lineNumber) + ": " + keyword + " " + what + " (the file is damaged)";
-    return false;
-  };
-  // "WORD type" at `at`: the type's size in binary files, and `at` past the line
-  auto header = [&](const char* word, std::size_t& width) {
-    const std::size_t length = std::strlen(word);
-    at = bytes.find_first_not_of(" \t\r\n", at);
-    if (at == std::string::npos || bytes.compare(at, length, word) != 0)
-    {
-      return false;
-    }
-    const std::size_t eol = bytes.find('\n', at);
-    if (eol == std::string::npos)
-    {
-      return false;
-    }
-    const std::string type = bytes.substr(at + length, eol - at - length);
-    width = type.find("64") != std::string::npos ? 8 : 4;
-    at = eol + 1;
-    return true;
-  };
-  // `count` integers from `at` (big-endian of `width` bytes in binary files)
-  auto read = [&](std::size_t count, std::size_t width, std::vector<long long>* out) {
-    if (binary)
-    {
-      if (at > bytes.size() || (bytes.size() - at) / width < count)
-      {
-        return false;
-      }
-      if (out)
-      {
-        const auto* b = reinterpret_cast<const unsigned char*>(bytes.data() + at);
-        for (std::size_t i = 0; i < count; ++i)
-        {
-          std::uint64_t v = 0;
-          for (std::size_t k = 0; k < width; ++k)
-          {
-            v = (v << 8) | b[i * width + k];
-          }
-          out->push_back(width == 8 ? static_cast<long long>(v) : static_cast<std::int32_t>(v));
-        }
-      }
-      at += count * width;
-      return true;
-    }
-    const char* cursor = bytes.c_str() + std::min(at, bytes.size());
-    for (std::size_t i = 0; i < count; ++i)
-    {
-      char* end = nullptr;
-      errno = 0;
-      const long long v = std::strtoll(cursor, &end, 10);
-      if (end == cursor || errno != 0)
-      {
-        return false;
-      }
-      cursor = end;
-      if (out)
-      {
-        out->push_back(v);
-      }
-    }
-    at = static_cast<std::size_t>(cursor - bytes.c_str());
-    return true;
-  };
-  std::size_t width = 4;
-  std::vector<long long> offsets;
-  offsets.reserve(n);
-  if (!header("OFFSETS", width) || !read(n, width, &offsets))
-  {
-    return refuse("declares " + std::to_string(n) + " offsets, but fewer are there");
-  }
-  if (!offsets.empty() && offsets.front() != 0)
-  {
-    return refuse("offsets must start at 0");
-  }
-  for (std::size_t i = 1; i < offsets.size(); ++i)
-  {
-    if (offsets[i] < offsets[i - 1])
-    {
-      return refuse("offset " + std::to_string(i + 1) + " is smaller than the one before");
-    }
-  }
-  if (!offsets.empty() && static_cast<unsigned long long>(offsets.back()) != values)
-  {
-    return refuse("offsets end at " + std::to_string(offsets.back()) + ", not at the " + std::to_string(values) +
-      " point ids declared");
-  }
-  if (!header("CONNECTIVITY", width) || !read(values, width, nullptr))
-  {
-    return refuse("declares " + std::to_string(values) + " point ids, but fewer are there");
-  }
-  return true;
-}
-
-bool checkLegacyCells(const std::string& bytes, std::size_t start, bool binary, double declaredCells,
-  double declaredValues, const std::string& keyword, int lineNumber, std::string& why)
-{
-  std::size_t first = bytes.find_first_not_of(" \t\r\n", start);
-  if (first != std::string::npos && bytes.compare(first, 7, "OFFSETS") == 0)
-  {
-    return checkLegacyCellsV5(bytes, start, binary, declaredCells, declaredValues, keyword, lineNumber, why);
-  }
-  const auto values = static_cast<std::size_t>(declaredValues); // fits: checked against the file size
-  auto refuse = [&](std::size_t cell, long long points, std::size_t at) {
-    std::ostringstream m;
-    m << "line " << lineNumber << ": " << keyword << " cell " << cell + 1 << " lists " << points
-      << " points, but only " << (values - at - 1) << " of the section's " << values
-      << " values are left for them (the file is damaged)";
-    why = m.str();
-    return false;
-  };
-  std::size_t cell = 0;
-  std::size_t at = 0; // index of the value being read
-  if (binary)
-  {
-    // big-endian 32-bit integers, right after the header line
-    if (start > bytes.size() || bytes.size() - start < 4 * values)
-    {
-      return true; // VTK refuses a short section itself
-    }
-    const auto* b = reinterpret_cast<const unsigned char*>(bytes.data() + start);
-    while (at < values)
-    {
-      const std::int32_t count = static_cast<std::int32_t>((std::uint32_t(b[4 * at]) << 24) |
-        (std::uint32_t(b[4 * at + 1]) << 16) | (std::uint32_t(b[4 * at + 2]) << 8) | std::uint32_t(b[4 * at + 3]));
-      if (count < 0 || static_cast<std::size_t>(count) > values - at - 1)
-      {
-        return refuse(cell, count, at);
-      }
-      at += 1 + static_cast<std::size_t>(count);
-      ++cell;
-    }
-    return true;
-  }
-  const char* cursor = bytes.c_str() + std::min(start, bytes.size());
-  std::size_t skip = 0; // values of the current cell still to pass over
-  while (at < values)
-  {
-    char* end = nullptr;
-    errno = 0;
-    const long long v = std::strtoll(cursor, &end, 10);
-    if (end == cursor || errno != 0)
-    {
-      return true; // not a number: VTK refuses the section itself
-    }
-    cursor = end;
-    if (skip > 0)
-    {
-      --skip;
-    }
-    else
-    {
-      if (v < 0 || static_cast<unsigned long long>(v) > values - at - 1)
-      {
-        return refuse(cell, v, at);
-      }
-      skip = static_cast<std::size_t>(v);
-      ++cell;
-    }
-    ++at;
-  }
-  return true;
-}
-
-/// Legacy VTK files: every count a section header declares (POINTS n, POLYGONS n size, ...,
-/// POINT_DATA n, field arrays "name components tuples type") must fit in the file (at least
-/// two bytes a value in ASCII, one in binary) before vtkPolyDataReader allocates for it: a
-/// header claiming a billion points made it allocate and loop for minutes.
-bool checkLegacyCounts(const std::string& bytes, std::string& why)
-{
-  const double size = static_cast<double>(bytes.size());
-  bool binary = false;
-  std::size_t pos = 0;
-  int lineNumber = 0;
-  double tuples = 0; // of the current POINT_DATA / CELL_DATA section
-  while (pos < bytes.size())
-  {
-    std::size_t end = bytes.find('\n', pos);
-    if (end == std::string::npos)
-    {
-      end = bytes.size();
-    }
-    const std::string line = bytes.substr(pos, std::min<std::size_t>(end - pos, 256));
-    pos = end + 1;
-    ++lineNumber;
-    if (lineNumber == 3)
-    {
-      binary = line.compare(0, 6, "BINARY") == 0;
-    }
-    std::istringstream in(line);
-    std::string keyword;
-    in >> keyword;
-    const double perValue = binary ? 1.0 : 2.0;
-    // a declared count as text (no conversion to an integer type: a header may declare 1e34)
-    auto count = [](double v) {
-      std::ostringstream c;
-      c << std::fixed << std::setprecision(0) << v;
-      return c.str();
-    };
-    auto tooLarge = [&](double values, const std::string& what) {
-      if (values * perValue <= size + 1.0)
-      {
-        return false;
-      }
-      std::ostringstream m;
-      m << "line " << lineNumber << " declares " << what << ", more than a file of " << bytes.size()
-        << " bytes can hold";
-      why = m.str();
-      return true;
-    };
-    if (keyword == "POINTS" || keyword == "POINT_DATA" || keyword == "CELL_DATA")
-    {
-      double n = -1;
-      if (!(in >> n) || n < 0)
-      {
-        why = "line " + std::to_string(lineNumber) + ": " + keyword + " needs a non-negative count";
-        return false;
-      }
-      if (tooLarge(keyword == "POINTS" ? 3 * n : n, count(n) + " " +
-              (keyword == "POINTS" ? "points" : "data tuples")))
-      {
-        return false;
-      }
-      if (keyword != "POINTS")
-      {
-        tuples = n;
-      }
-    }
-    else if (keyword == "SCALARS" || keyword == "COLOR_SCALARS" || keyword == "LOOKUP_TABLE")
-    {
-      // values per tuple (SCALARS name type [components], COLOR_SCALARS name components) times
-      // the tuples of the data section, or a lookup table's 4 values per entry (LOOKUP_TABLE
-      // name size): VTK allocates for them before reading (SCALARS with 1e8 components on 4
-      // points allocated 7 GB)
-      std::string name, type;
-      double components = 1;
-      double values = -1;
-      if (keyword == "SCALARS")
-      {
-        if ((in >> name >> type) && (in >> components))
-        {
-          values = components * tuples;
-        }
-        else
-        {
-          values = tuples;
-        }
-      }
-      else if (keyword == "COLOR_SCALARS")
-      {
-        if (in >> name >> components)
-        {
-          values = components * tuples;
-        }
-      }
-      else if ((in >> name >> components))
-      {
-        values = 4 * components; // LOOKUP_TABLE name size ("LOOKUP_TABLE default" has none)
-      }
-      if (components < 0)
-      {
-        why = "line " + std::to_string(lineNumber) + ": " + keyword + " needs a non-negative count";
-        return false;
-      }
-      if (values >= 0 && tooLarge(values, keyword + " " + name + " of " + count(values) + " values"))
-      {
-        return false;
-      }
-    }
-    else if (keyword == "VERTICES" || keyword == "LINES" || keyword == "POLYGONS" || keyword == "TRIANGLE_STRIPS")
-    {
-      double n = -1, values = -1;
-      if (!(in >> n >> values) || n < 0 || values < 0)
-      {
-        why = "line " + std::to_string(lineNumber) + ": " + keyword + " needs two non-negative counts";
-        return false;
-      }
-      if (tooLarge(std::max(n, values), count(n) + " cells of " +
-              count(values) + " values"))
-      {
-        return false;
-      }
-      if (!checkLegacyCells(bytes, pos, binary, n, values, keyword, lineNumber, why))
-      {
-        return false;
-      }
-    }
-    else if (!keyword.empty())
-    {
-      // a field array: "name components tuples type"
-      double components = -1, tuples = -1;
-      std::string type, extra;
-      if ((in >> components >> tuples >> type) && !(in >> extra) && components >= 0 && tuples >= 0 &&
-        (type == "float" || type == "double" || type == "int" || type == "vtkIdType" || type == "char" ||
-          type == "unsigned_char" || type == "short" || type == "unsigned_short" || type == "unsigned_int" ||
-          type == "long" || type == "unsigned_long" || type == "vtktypeint64" || type == "vtktypeuint64" ||
-          type == "bit" || type == "string"))
-      {
-        if (tooLarge(components * tuples, "an array of " + count(tuples) +
-                " tuples"))
-        {
-          return false;
-        }
-      }
     }
   }
   return true;
@@ -662,31 +335,23 @@ vtkSmartPointer<vtkPolyData> readMesh(
     reader->GetCellDataArraySelection()->DisableAllArrays();
     run(reader);
   }
-  else // ".vtk"
+  else // ".vtk": our own parser (CLIVTK.cxx says why not vtkPolyDataReader)
   {
     std::string bytes;
-    std::string why;
     if (!slurp(path, bytes))
     {
       error = "cannot read '" + path + "': read error";
       return nullptr;
     }
-    if (!checkLegacyCounts(bytes, why))
+    ParsedMesh parsed;
+    std::string why;
+    if (!parseLegacyVTK(bytes.data(), bytes.size(), parsed, why, cancelled))
     {
-      error = "cannot read '" + path + "': " + why;
+      error = why == "interrupted" ? why : "cannot read '" + path + "': " + why;
       return nullptr;
     }
     bytes = std::string();
-    vtkNew<vtkPolyDataReader> reader;
-    reader->SetFileName(path.c_str());
-    if (!reader->IsFilePolyData())
-    {
-      error = "cannot read '" + path +
-        "': not a legacy VTK POLYDATA file (other dataset types are not surfaces; extract one "
-        "first, e.g. with vtkGeometryFilter)";
-      return nullptr;
-    }
-    run(reader);
+    mesh = toPolyData(parsed);
   }
   if (cancelled && cancelled())
   {

@@ -1,4 +1,4 @@
-// SDFCage — CLI: PLY and OBJ parsers that check everything they read.
+// SDFCage — CLI: PLY, OBJ and legacy VTK parsers that check everything they read.
 //
 // PLY: VTK's vtkPLYReader trusts the header: a binary file whose header claims a billion vertices
 // makes it loop (and allocate) for a billion elements past the end of the file, and a short
@@ -48,6 +48,14 @@ bool parsePLY(const char* data, std::size_t size, ParsedMesh& mesh, std::string&
 
 /// Parses a whole OBJ file held in memory; same contract as parsePLY.
 bool parseOBJ(const char* data, std::size_t size, ParsedMesh& mesh, std::string& error,
+  const std::function<bool()>& cancelled = {});
+
+/// Parses a whole legacy VTK POLYDATA file (.vtk, ASCII or BINARY, cell lists before and from
+/// version 5) held in memory; same contract as parsePLY. The points and the polygons are read
+/// (triangle strips split into triangles; vertices, lines and FIELD data read past); reading
+/// stops at POINT_DATA / CELL_DATA, whose arrays a cage does not need. See CLIVTK.cxx for why
+/// this is not vtkPolyDataReader.
+bool parseLegacyVTK(const char* data, std::size_t size, ParsedMesh& mesh, std::string& error,
   const std::function<bool()>& cancelled = {});
 
 } // namespace sdfcage_cli
