@@ -18,11 +18,9 @@
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkPolyDataWriter.h>
-#include <vtkSTLReader.h>
 #include <vtkSTLWriter.h>
 #include <vtkXMLPolyDataReader.h>
 #include <vtkXMLPolyDataWriter.h>
-#include <vtksys/SystemTools.hxx>
 
 #include <algorithm>
 #include <cctype>
@@ -155,36 +153,6 @@ bool checkXMLComponents(const std::string& bytes, std::string& why)
   return true;
 }
 
-/// Binary STL: 80 bytes of header, the triangle count, 50 bytes a triangle. Whether the file is
-/// binary is decided as vtkSTLReader decides it (vtksys' DetectFileType on the first bytes, also
-/// for a file that starts with "solid"), so that the count it would trust is checked.
-bool checkBinarySTL(const std::string& path, std::uintmax_t size, std::string& why)
-{
-  if (vtksys::SystemTools::DetectFileType(path.c_str()) == vtksys::SystemTools::FileTypeText)
-  {
-    return true; // read as ASCII by VTK
-  }
-  std::ifstream in(path, std::ios::binary);
-  char head[84] = {};
-  in.read(head, sizeof(head));
-  const std::streamsize got = in.gcount();
-  if (got < 84)
-  {
-    why = "a binary STL file needs at least 84 bytes (header and triangle count), this one has " +
-      std::to_string(size);
-    return false;
-  }
-  const auto* b = reinterpret_cast<const unsigned char*>(head + 80);
-  const std::uint64_t count = b[0] | (b[1] << 8) | (b[2] << 16) | (static_cast<std::uint64_t>(b[3]) << 24);
-  if (84 + 50 * count > size)
-  {
-    why = "the binary STL header declares " + std::to_string(count) + " triangles (" +
-      std::to_string(84 + 50 * count) + " bytes), the file has " + std::to_string(size) + " bytes";
-    return false;
-  }
-  return true;
-}
-
 } // namespace
 
 const char* supportedExtensions()
@@ -263,46 +231,40 @@ vtkSmartPointer<vtkPolyData> readMesh(
     errorCode = reader->GetErrorCode();
     mesh = vtkPolyData::SafeDownCast(reader->GetOutputDataObject(0));
   };
+  // the whole file in memory, then one of our parsers (same contract: CLIParsers.h)
+  using Parser = bool (*)(const char*, std::size_t, ParsedMesh&, std::string&, const std::function<bool()>&);
+  auto parseOwn = [&](Parser parse) {
+    std::string bytes;
+    if (!slurp(path, bytes))
+    {
+      error = "cannot read '" + path + "': read error";
+      return false;
+    }
+    ParsedMesh parsed;
+    std::string why;
+    if (!parse(bytes.data(), bytes.size(), parsed, why, cancelled))
+    {
+      error = why == "interrupted" ? why : "cannot read '" + path + "': " + why;
+      return false;
+    }
+    bytes = std::string();
+    mesh = toPolyData(parsed);
+    return true;
+  };
   if (ext == ".off")
   {
     vtkNew<vtkOFFReader> reader;
     reader->SetFileName(path.c_str());
     run(reader);
   }
-  else if (ext == ".obj" || ext == ".ply")
+  else if (ext == ".obj" || ext == ".ply" || ext == ".stl")
   {
-    // our own parsers: vtkPLYReader trusts the header's counts, vtkOBJReader reads bad numbers
-    // as other numbers (see CLIParsers.h)
-    std::string bytes;
-    if (!slurp(path, bytes))
+    // our own parsers (CLIParsers.h, and each file's head says why not VTK's reader): vtkPLYReader
+    // and vtkSTLReader trust the counts of the file, vtkOBJReader reads bad numbers as other numbers
+    if (!parseOwn(ext == ".ply" ? parsePLY : ext == ".obj" ? parseOBJ : parseSTL))
     {
-      error = "cannot read '" + path + "': read error";
       return nullptr;
     }
-    ParsedMesh parsed;
-    std::string why;
-    const bool ok = ext == ".ply" ? parsePLY(bytes.data(), bytes.size(), parsed, why, cancelled)
-                                  : parseOBJ(bytes.data(), bytes.size(), parsed, why, cancelled);
-    if (!ok)
-    {
-      error = why == "interrupted" ? why : "cannot read '" + path + "': " + why;
-      return nullptr;
-    }
-    bytes = std::string();
-    mesh = toPolyData(parsed);
-  }
-  else if (ext == ".stl")
-  {
-    std::string why;
-    if (!checkBinarySTL(path, fileSize, why))
-    {
-      error = "cannot read '" + path + "': " + why;
-      return nullptr;
-    }
-    vtkNew<vtkSTLReader> reader;
-    reader->SetFileName(path.c_str());
-    reader->MergingOn(); // STL stores triangle soup: merge coincident points to get a surface
-    run(reader);
   }
   else if (ext == ".vtp")
   {
@@ -335,23 +297,9 @@ vtkSmartPointer<vtkPolyData> readMesh(
     reader->GetCellDataArraySelection()->DisableAllArrays();
     run(reader);
   }
-  else // ".vtk": our own parser (CLIVTK.cxx says why not vtkPolyDataReader)
+  else if (!parseOwn(parseLegacyVTK)) // ".vtk": our own parser (CLIVTK.cxx says why not vtkPolyDataReader)
   {
-    std::string bytes;
-    if (!slurp(path, bytes))
-    {
-      error = "cannot read '" + path + "': read error";
-      return nullptr;
-    }
-    ParsedMesh parsed;
-    std::string why;
-    if (!parseLegacyVTK(bytes.data(), bytes.size(), parsed, why, cancelled))
-    {
-      error = why == "interrupted" ? why : "cannot read '" + path + "': " + why;
-      return nullptr;
-    }
-    bytes = std::string();
-    mesh = toPolyData(parsed);
+    return nullptr;
   }
   if (cancelled && cancelled())
   {

@@ -1,4 +1,4 @@
-// SDFCage — CLI: PLY, OBJ and legacy VTK parsers that check everything they read.
+// SDFCage — CLI: PLY, OBJ, STL and legacy VTK parsers that check everything they read.
 //
 // PLY: VTK's vtkPLYReader trusts the header: a binary file whose header claims a billion vertices
 // makes it loop (and allocate) for a billion elements past the end of the file, and a short
@@ -48,6 +48,13 @@ bool parsePLY(const char* data, std::size_t size, ParsedMesh& mesh, std::string&
 
 /// Parses a whole OBJ file held in memory; same contract as parsePLY.
 bool parseOBJ(const char* data, std::size_t size, ParsedMesh& mesh, std::string& error,
+  const std::function<bool()>& cancelled = {});
+
+/// Parses a whole STL file (binary or ASCII) held in memory; same contract as parsePLY. Points
+/// with equal coordinates are merged (STL repeats every corner). Binary when the size is what the
+/// triangle count says, ASCII when the file starts with "solid", binary otherwise; no triangles
+/// at all is an error. See CLISTL.cxx for why this is not vtkSTLReader.
+bool parseSTL(const char* data, std::size_t size, ParsedMesh& mesh, std::string& error,
   const std::function<bool()>& cancelled = {});
 
 /// Parses a whole legacy VTK POLYDATA file (.vtk, ASCII or BINARY, cell lists before and from

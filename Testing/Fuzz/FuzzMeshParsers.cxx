@@ -1,4 +1,4 @@
-// SDFCage — fuzz harness: the CLI's PLY, OBJ and legacy VTK parsers (Examples/CLI/CLIParsers.h) on any bytes.
+// SDFCage — fuzz harness: the CLI's PLY, OBJ, STL and legacy VTK parsers (Examples/CLI/CLIParsers.h) on any bytes.
 // Whatever they accept must be a consistent mesh: three coordinates a point, offsets rising
 // from 0 to the connectivity's end, every index inside [0, points).
 #include "CLIParsers.h"
@@ -49,6 +49,15 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   }
   error.clear();
   if (sdfcage_cli::parseOBJ(text, size, mesh, error))
+  {
+    checkConsistent(mesh);
+  }
+  else if (error.empty())
+  {
+    std::abort();
+  }
+  error.clear();
+  if (sdfcage_cli::parseSTL(text, size, mesh, error))
   {
     checkConsistent(mesh);
   }

@@ -1,8 +1,10 @@
-// SDFCage — tests of the CLI's legacy VTK parser (Examples/CLI/CLIVTK.cxx): on files written by
-// VTK's own vtkPolyDataWriter (ASCII and binary, file versions 4.2 and 5.1, with FIELD data
-// holding numbers and strings, point and cell data with METADATA, triangle strips, lines and
-// vertices), it must read the same points and the same triangles as vtkPolyDataReader; and it
-// must refuse damaged files with a reason.
+// SDFCage — tests of the CLI's own legacy VTK and STL parsers (Examples/CLI/CLIVTK.cxx,
+// CLISTL.cxx). Legacy VTK: on files written by VTK's own vtkPolyDataWriter (ASCII and binary, file
+// versions 4.2 and 5.1, with FIELD data holding numbers and strings, point and cell data with
+// METADATA, triangle strips, lines and vertices), it must read the same points and the same
+// triangles as vtkPolyDataReader. STL: on what vtkSTLWriter writes (ASCII and binary), the same
+// merged points and triangles as vtkSTLReader with merging. Both must refuse damaged files with a
+// reason.
 #include "CLIParsers.h"
 
 #include <vtkCellArray.h>
@@ -18,6 +20,8 @@
 #include <vtkPolyDataNormals.h>
 #include <vtkPolyDataReader.h>
 #include <vtkPolyDataWriter.h>
+#include <vtkSTLReader.h>
+#include <vtkSTLWriter.h>
 #include <vtkSphereSource.h>
 #include <vtkStringArray.h>
 #include <vtkStripper.h>
@@ -26,6 +30,8 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <fstream>
+#include <iterator>
 #include <array>
 #include <string>
 #include <vector>
@@ -274,4 +280,143 @@ TEST(LegacyVTKParser, PointDataIsNotReadAndCannotHurt)
   std::string error;
   ASSERT_TRUE(sdfcage_cli::parseLegacyVTK(text.data(), text.size(), mesh, error)) << error;
   EXPECT_EQ(mesh.Offsets.size(), 2u);
+}
+
+namespace
+{
+
+using CornerTriangle = std::array<std::array<double, 3>, 3>;
+
+/// The triangles as corner coordinates, each rotated to start at its smallest corner, sorted.
+std::vector<CornerTriangle> cornerTriangles(const std::vector<double>& points, const std::vector<std::int64_t>& ids)
+{
+  std::vector<CornerTriangle> out;
+  for (std::size_t t = 0; t + 2 < ids.size(); t += 3)
+  {
+    CornerTriangle tri;
+    for (int c = 0; c < 3; ++c)
+    {
+      for (int k = 0; k < 3; ++k)
+      {
+        tri[c][k] = points[3 * static_cast<std::size_t>(ids[t + c]) + k];
+      }
+    }
+    std::rotate(tri.begin(), std::min_element(tri.begin(), tri.end()), tri.end());
+    out.push_back(tri);
+  }
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+std::string fileBytes(const std::string& path)
+{
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+} // namespace
+
+TEST(STLParser, ReadsWhatVTKWritesLikeVTKReadsIt)
+{
+  vtkNew<vtkSphereSource> sphere;
+  sphere->SetThetaResolution(13);
+  sphere->SetPhiResolution(9);
+  for (const bool binary : { false, true })
+  {
+    SCOPED_TRACE(binary ? "binary" : "ascii");
+    const std::string path = std::string("sdfcage_parser_test_") + (binary ? "binary" : "ascii") + ".stl";
+    vtkNew<vtkSTLWriter> writer;
+    writer->SetInputConnection(sphere->GetOutputPort());
+    writer->SetFileName(path.c_str());
+    if (binary)
+    {
+      writer->SetFileTypeToBinary();
+    }
+    else
+    {
+      writer->SetFileTypeToASCII();
+    }
+    writer->Write();
+    vtkNew<vtkSTLReader> reader;
+    reader->SetFileName(path.c_str());
+    reader->MergingOn();
+    reader->Update();
+    vtkPolyData* reference = reader->GetOutput();
+
+    const std::string bytes = fileBytes(path);
+    std::remove(path.c_str());
+    sdfcage_cli::ParsedMesh mesh;
+    std::string error;
+    ASSERT_TRUE(sdfcage_cli::parseSTL(bytes.data(), bytes.size(), mesh, error)) << error;
+    ASSERT_EQ(mesh.Points.size(), 3 * static_cast<std::size_t>(reference->GetNumberOfPoints()));
+    ASSERT_EQ(mesh.Offsets.size() - 1, static_cast<std::size_t>(reference->GetNumberOfPolys()));
+    std::vector<double> theirPoints(3 * reference->GetNumberOfPoints());
+    for (vtkIdType i = 0; i < reference->GetNumberOfPoints(); ++i)
+    {
+      reference->GetPoint(i, theirPoints.data() + 3 * i);
+    }
+    std::vector<std::int64_t> theirIds;
+    for (vtkIdType t = 0; t < reference->GetNumberOfPolys(); ++t)
+    {
+      const vtkIdType* c = nullptr;
+      vtkIdType n = 0;
+      reference->GetCellPoints(t, n, c);
+      ASSERT_EQ(n, 3);
+      theirIds.insert(theirIds.end(), c, c + 3);
+    }
+    EXPECT_EQ(mesh.Connectivity.size(), theirIds.size());
+    EXPECT_EQ(cornerTriangles(mesh.Points, mesh.Connectivity), cornerTriangles(theirPoints, theirIds));
+    EXPECT_EQ(mesh.Points.size() / 3, 93u); // a closed 13 x 9 sphere: 13 * 7 + 2 points, merged
+  }
+}
+
+TEST(STLParser, BinaryAndASCIIEdgeCases)
+{
+  // a binary file whose header starts with "solid" (as some exporters write): read as binary,
+  // since its size is what its count says
+  std::string binary(80, ' ');
+  binary.replace(0, 9, "solid abc");
+  const std::uint32_t one = 1;
+  binary.append(reinterpret_cast<const char*>(&one), 4);
+  const float corners[12] = { 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0 }; // normal, then 3 corners
+  binary.append(reinterpret_cast<const char*>(corners), sizeof(corners));
+  binary.append(2, '\0');
+  sdfcage_cli::ParsedMesh mesh;
+  std::string error;
+  ASSERT_TRUE(sdfcage_cli::parseSTL(binary.data(), binary.size(), mesh, error)) << error;
+  EXPECT_EQ(mesh.Points, (std::vector<double>{ 0, 0, 0, 1, 0, 0, 0, 1, 0 }));
+
+  // ASCII in any case, two solids, a facet of two corners skipped, shared corners merged
+  const std::string text = "SOLID one\n facet normal 0 0 1\n  outer loop\n   vertex 0 0 0\n   vertex 1 0 0\n"
+                           "   vertex 0 1 0\n  endloop\n endfacet\nendsolid one\nsolid two\nFacet Normal 0 0 1\n"
+                           "Outer Loop\nVertex 1 0 0\nVertex 1 1 0\nVertex 0 1 0\nEndLoop\nEndFacet\n"
+                           "facet normal 0 0 1\nouter loop\nvertex 5 5 5\nvertex 6 6 6\nendloop\nendfacet\nendsolid\n";
+  ASSERT_TRUE(sdfcage_cli::parseSTL(text.data(), text.size(), mesh, error)) << error;
+  EXPECT_EQ(mesh.Points.size(), 3u * 6u); // 4 used, 2 of the facet dropped (kept, as other readers keep them)
+  EXPECT_EQ(mesh.Offsets.size(), 3u);
+  EXPECT_EQ(mesh.SkippedFaces, 1);
+
+  struct Case
+  {
+    std::string bytes;
+    std::string reason;
+  };
+  std::string truncated = binary.substr(0, binary.size() - 10);
+  std::string noTriangles = binary.substr(0, 80) + std::string(4, '\0');
+  const std::vector<Case> cases = {
+    { "", "empty" },
+    { "solid x\nendsolid x\n", "no triangles" },
+    { noTriangles, "no triangles" },
+    { truncated, "declares 1 triangles" },
+    { "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 zz\n", "three numbers" },
+    { "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nendfacet\n", "'vertex' or 'endloop'" },
+    { "solid c\n" + std::string(200, '\x83'), "nor a binary one" },
+    { "garbage", "at least 84 bytes" },
+  };
+  for (const Case& c : cases)
+  {
+    EXPECT_FALSE(sdfcage_cli::parseSTL(c.bytes.data(), c.bytes.size(), mesh, error)) << c.bytes;
+    EXPECT_NE(error.find(c.reason), std::string::npos) << "'" << error << "'";
+    EXPECT_TRUE(mesh.Points.empty());
+  }
 }
