@@ -65,4 +65,9 @@ bool parseSTL(const char* data, std::size_t size, ParsedMesh& mesh, std::string&
 bool parseLegacyVTK(const char* data, std::size_t size, ParsedMesh& mesh, std::string& error,
   const std::function<bool()>& cancelled = {});
 
+/// The parsers' tokenizer: the next white-space separated word of [p, end) into `out` (at most
+/// 257 characters: longer ones come in pieces, which no keyword or number matches), lower-cased
+/// when `lower`; `p` is left after it. False at the end.
+bool nextWord(const char*& p, const char* end, std::string& out, bool lower);
+
 } // namespace sdfcage_cli

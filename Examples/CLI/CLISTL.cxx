@@ -140,24 +140,7 @@ bool parseASCIISTL(const char* data, std::size_t size, ParsedMesh& mesh, std::st
   const char* p = data;
   const char* const end = data + size;
   std::string word;
-  auto next = [&](bool lower) {
-    while (p < end && std::isspace(static_cast<unsigned char>(*p)))
-    {
-      ++p;
-    }
-    const char* start = p;
-    while (p < end && !std::isspace(static_cast<unsigned char>(*p)) && p - start <= 256)
-    {
-      ++p;
-    }
-    word.assign(start, p);
-    if (lower)
-    {
-      std::transform(word.begin(), word.end(), word.begin(),
-        [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    }
-    return !word.empty();
-  };
+  auto next = [&](bool lower) { return nextWord(p, end, word, lower); };
   auto fail = [&](const std::string& why) {
     error = "line " + std::to_string(1 + std::count(data, p, '\n')) + ": " + why;
     return false;

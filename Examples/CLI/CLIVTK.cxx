@@ -101,25 +101,7 @@ private:
   std::size_t left() const { return static_cast<std::size_t>(End - P); }
 
   /// The next white-space separated word (at most 256 characters), lower-cased when `lower`.
-  bool word(std::string& out, bool lower = true)
-  {
-    while (P < End && isSpace(*P))
-    {
-      ++P;
-    }
-    const char* start = P;
-    while (P < End && !isSpace(*P) && P - start <= 256)
-    {
-      ++P;
-    }
-    out.assign(start, P);
-    if (lower)
-    {
-      std::transform(out.begin(), out.end(), out.begin(),
-        [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    }
-    return !out.empty();
-  }
+  bool word(std::string& out, bool lower = true) { return nextWord(P, End, out, lower); }
   /// Past the end of the current line (binary data starts after it).
   void skipLine()
   {
@@ -676,6 +658,27 @@ bool LegacyParser::parse(ParsedMesh& mesh, std::string& error)
 }
 
 } // namespace
+
+bool nextWord(const char*& p, const char* end, std::string& out, bool lower)
+{
+  auto space = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f'; };
+  while (p < end && space(*p))
+  {
+    ++p;
+  }
+  const char* start = p;
+  while (p < end && !space(*p) && p - start <= 256)
+  {
+    ++p;
+  }
+  out.assign(start, p);
+  if (lower)
+  {
+    std::transform(out.begin(), out.end(), out.begin(),
+      [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  }
+  return !out.empty();
+}
 
 bool parseLegacyVTK(
   const char* data, std::size_t size, ParsedMesh& mesh, std::string& error, const std::function<bool()>& cancelled)
