@@ -26,6 +26,11 @@ namespace sdfcage_cli
 namespace
 {
 
+bool isSpace(char c)
+{
+  return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f';
+}
+
 /// Byte width of a legacy VTK data type in binary files (big-endian); 0 when unsupported.
 /// vtkIdType is written as a 32-bit int by VTK's legacy writer; "long" is 64-bit on this
 /// platform, as VTK reads it.
@@ -94,10 +99,6 @@ private:
     }
     return true;
   }
-  static bool isSpace(char c)
-  {
-    return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f';
-  }
   std::size_t left() const { return static_cast<std::size_t>(End - P); }
 
   /// The next white-space separated word (at most 256 characters), lower-cased when `lower`.
@@ -139,8 +140,10 @@ private:
     n = static_cast<std::size_t>(v);
     return true;
   }
-  /// `n` numbers of `type` as doubles (out may be null: skipped).
-  bool numbers(std::size_t n, const std::string& type, std::vector<double>* out, const std::string& what)
+  /// Reads `n` values of `type` and hands each to `sink(value, index)` (false: stop, failed),
+  /// or with `skip` only checks them (ASCII) or steps over them (binary).
+  template <class Sink>
+  bool eachValue(std::size_t n, const std::string& type, const std::string& what, bool skip, Sink&& sink)
   {
     const std::size_t width = typeWidth(type);
     if (width == 0)
@@ -154,53 +157,48 @@ private:
       {
         return fail(P, what + ": " + std::to_string(n) + " values declared, the file ends before");
       }
-      if (out)
+      const auto* b = reinterpret_cast<const unsigned char*>(P);
+      P += n * width;
+      if (skip)
       {
-        out->reserve(out->size() + n);
-        const auto* b = reinterpret_cast<const unsigned char*>(P);
-        const bool isFloat = type == "float" || type == "double";
-        const bool isSigned = type.compare(0, 8, "unsigned") != 0 && type != "vtktypeuint64";
-        for (std::size_t i = 0; i < n; ++i, b += width)
+        return true;
+      }
+      const bool isFloat = type == "float" || type == "double";
+      const bool isSigned = type.compare(0, 8, "unsigned") != 0 && type != "vtktypeuint64";
+      for (std::size_t i = 0; i < n; ++i, b += width)
+      {
+        std::uint64_t bits = 0;
+        for (std::size_t k = 0; k < width; ++k)
         {
-          std::uint64_t bits = 0;
-          for (std::size_t k = 0; k < width; ++k)
-          {
-            bits = (bits << 8) | b[k];
-          }
-          double value = 0;
-          if (isFloat && width == 4)
-          {
-            const auto u = static_cast<std::uint32_t>(bits);
-            float f;
-            std::memcpy(&f, &u, 4);
-            value = f;
-          }
-          else if (isFloat)
-          {
-            std::memcpy(&value, &bits, 8);
-          }
-          else if (isSigned)
-          {
-            const unsigned shift = static_cast<unsigned>(64 - 8 * width);
-            value = static_cast<double>(static_cast<std::int64_t>(bits << shift) >> shift);
-          }
-          else
-          {
-            value = static_cast<double>(bits);
-          }
-          out->push_back(value);
-          if (!poll())
-          {
-            return false;
-          }
+          bits = (bits << 8) | b[k];
+        }
+        double value = 0;
+        if (isFloat && width == 4)
+        {
+          const auto u = static_cast<std::uint32_t>(bits);
+          float f;
+          std::memcpy(&f, &u, 4);
+          value = f;
+        }
+        else if (isFloat)
+        {
+          std::memcpy(&value, &bits, 8);
+        }
+        else if (isSigned)
+        {
+          const unsigned shift = static_cast<unsigned>(64 - 8 * width);
+          value = static_cast<double>(static_cast<std::int64_t>(bits << shift) >> shift);
+        }
+        else
+        {
+          value = static_cast<double>(bits);
+        }
+        if (!sink(value, i) || !poll())
+        {
+          return false;
         }
       }
-      P += n * width;
       return true;
-    }
-    if (out)
-    {
-      out->reserve(out->size() + n);
     }
     std::string text;
     const bool isFloat = type == "float";
@@ -224,16 +222,24 @@ private:
         v = std::fabs(v) > std::numeric_limits<float>::max() ? (v > 0 ? 1.0 : -1.0) * std::numeric_limits<double>::infinity()
                                                             : static_cast<double>(static_cast<float>(v));
       }
-      if (out)
-      {
-        out->push_back(v);
-      }
-      if (!poll())
+      if ((!skip && !sink(v, i)) || !poll())
       {
         return false;
       }
     }
     return true;
+  }
+  /// `n` numbers of `type` appended to `out` as doubles (out null: skipped).
+  bool numbers(std::size_t n, const std::string& type, std::vector<double>* out, const std::string& what)
+  {
+    if (out)
+    {
+      out->reserve(out->size() + n);
+    }
+    return eachValue(n, type, what, out == nullptr, [&](double v, std::size_t) {
+      out->push_back(v);
+      return true;
+    });
   }
   /// `n` integers (point counts, ids, offsets) of `type`, checked to be integers.
   bool integers(std::size_t n, const std::string& type, std::vector<long long>& out, const std::string& what)
@@ -242,22 +248,16 @@ private:
     {
       return fail(P, what + ": integers needed, the type is " + type);
     }
-    std::vector<double> values;
-    if (!numbers(n, type, &values, what))
-    {
-      return false;
-    }
-    out.resize(values.size());
-    for (std::size_t i = 0; i < values.size(); ++i)
-    {
-      const double v = values[i];
+    out.clear();
+    out.reserve(n);
+    return eachValue(n, type, what, false, [&](double v, std::size_t i) {
       if (!(std::fabs(v) < 9e15) || v != std::floor(v))
       {
         return fail(P, what + ": value " + std::to_string(i + 1) + " is not an integer");
       }
-      out[i] = static_cast<long long>(v);
-    }
-    return true;
+      out.push_back(static_cast<long long>(v));
+      return true;
+    });
   }
   /// "METADATA" blocks (after an array): lines up to the first empty one.
   void skipMetadata()
@@ -402,20 +402,13 @@ bool LegacyParser::cells(const std::string& keyword, const char* headerAt, Parse
   {
     return false;
   }
-  // version 5: the next line is "OFFSETS type"
-  const char* afterHeader = P;
+  // version 5: the line after the header is "OFFSETS type"
+  const char* afterCounts = P;
   skipLine();
-  const char* lineAfter = P;
-  P = afterHeader;
-  bool v5 = false;
+  const bool v5 = next("offsets");
+  if (!v5)
   {
-    const char* save = P;
-    P = lineAfter;
-    v5 = next("offsets");
-    if (!v5)
-    {
-      P = save;
-    }
+    P = afterCounts;
   }
   std::vector<long long> offsets, ids;
   if (v5)
@@ -661,13 +654,12 @@ bool LegacyParser::parse(ParsedMesh& mesh, std::string& error)
 
 bool nextWord(const char*& p, const char* end, std::string& out, bool lower)
 {
-  auto space = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n' || c == '\v' || c == '\f'; };
-  while (p < end && space(*p))
+  while (p < end && isSpace(*p))
   {
     ++p;
   }
   const char* start = p;
-  while (p < end && !space(*p) && p - start <= 256)
+  while (p < end && !isSpace(*p) && p - start <= 256)
   {
     ++p;
   }
