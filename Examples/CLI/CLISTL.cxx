@@ -78,6 +78,13 @@ private:
   std::unordered_map<Key, std::int64_t, Hash> Ids;
 };
 
+/// The triangle count a binary STL's header declares (32-bit little-endian at byte 80; the caller
+/// has checked that there are 84 bytes).
+std::uint64_t declaredCount(const unsigned char* data)
+{
+  return data[80] | (data[81] << 8) | (data[82] << 16) | (std::uint64_t(data[83]) << 24);
+}
+
 /// Whether a binary STL's triangle count fits its size (the count in `count`), or why not.
 bool binaryCountFits(const unsigned char* data, std::size_t size, std::uint64_t& count, std::string& error)
 {
@@ -87,7 +94,7 @@ bool binaryCountFits(const unsigned char* data, std::size_t size, std::uint64_t&
       std::to_string(size);
     return false;
   }
-  count = data[80] | (data[81] << 8) | (data[82] << 16) | (std::uint64_t(data[83]) << 24);
+  count = declaredCount(data);
   if (84 + 50 * count > size)
   {
     error = "the binary STL header declares " + std::to_string(count) + " triangles (" +
@@ -249,39 +256,22 @@ bool parseSTL(
   {
     solid = std::tolower(bytes[lead + k]) == "solid"[k];
   }
-  bool binaryBySize = false;
-  if (size >= 84)
-  {
-    const std::uint64_t count = bytes[80] | (bytes[81] << 8) | (bytes[82] << 16) | (std::uint64_t(bytes[83]) << 24);
-    binaryBySize = 84 + 50 * count == size;
-  }
-  bool ok = false;
-  if (solid && !binaryBySize)
-  {
-    ok = parseASCIISTL(data, size, mesh, error, cancelled);
-    if (ok && mesh.Offsets.size() == 1)
-    {
-      error = "the file holds no triangles";
-      ok = false;
-    }
-    if (!ok && error != "interrupted")
-    {
-      // Never read as binary then (a damaged ASCII file would give garbage triangles), but say
-      // what a binary reading would have found: a text start with binary bytes after it.
-      std::string binaryWhy;
-      std::uint64_t count = 0;
-      error = "not a valid ASCII STL (" + error + ")" +
-        (binaryCountFits(bytes, size, count, binaryWhy) ? std::string() : ", nor a binary one (" + binaryWhy + ")");
-    }
-  }
-  else
-  {
-    ok = parseBinarySTL(bytes, size, mesh, error, cancelled);
-  }
+  const bool binaryBySize = size >= 84 && 84 + 50 * declaredCount(bytes) == size;
+  const bool ascii = solid && !binaryBySize;
+  bool ok = ascii ? parseASCIISTL(data, size, mesh, error, cancelled) : parseBinarySTL(bytes, size, mesh, error, cancelled);
   if (ok && mesh.Offsets.size() == 1)
   {
     error = "the file holds no triangles";
     ok = false;
+  }
+  if (!ok && ascii && error != "interrupted")
+  {
+    // Never read as binary then (a damaged ASCII file would give garbage triangles), but say
+    // what a binary reading would have found: a text start with binary bytes after it.
+    std::string binaryWhy;
+    std::uint64_t count = 0;
+    error = "not a valid ASCII STL (" + error + ")" +
+      (binaryCountFits(bytes, size, count, binaryWhy) ? std::string() : ", nor a binary one (" + binaryWhy + ")");
   }
   if (!ok)
   {
