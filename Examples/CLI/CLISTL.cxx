@@ -258,7 +258,8 @@ bool parseSTL(
   }
   const bool binaryBySize = size >= 84 && 84 + 50 * declaredCount(bytes) == size;
   const bool ascii = solid && !binaryBySize;
-  bool ok = ascii ? parseASCIISTL(data, size, mesh, error, cancelled) : parseBinarySTL(bytes, size, mesh, error, cancelled);
+  bool ok =
+    ascii ? parseASCIISTL(data, size, mesh, error, cancelled) : parseBinarySTL(bytes, size, mesh, error, cancelled);
   if (ok && mesh.Offsets.size() == 1)
   {
     error = "the file holds no triangles";
