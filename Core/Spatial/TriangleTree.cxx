@@ -141,6 +141,8 @@ void TriangleTree::build(const TriangleMesh& mesh)
 bool TriangleTree::build(const TriangleMesh& mesh, Progress* progress, bool splitLong)
 {
   Nodes.clear();
+  QueryNodes.clear();
+  Root = { 0, 0 };
   Dipoles.clear();
   Tri.clear();
   Pieces.clear();
@@ -231,6 +233,7 @@ bool TriangleTree::build(const TriangleMesh& mesh, Progress* progress, bool spli
   if (progressCancelled(progress))
   {
     Nodes.clear(); // some subtrees were skipped: nothing of it may be used
+    QueryNodes.clear();
     Normals.clear();
     SplitTriangles = 0;
     return false;
@@ -248,7 +251,90 @@ bool TriangleTree::build(const TriangleMesh& mesh, Progress* progress, bool spli
       Pieces[i] = pieces[items[i].Id];
     }
   }
+  this->buildQueryNodes();
   return true;
+}
+
+namespace
+{
+// float bounds of a double coordinate: never above (down) or below (up) it
+float roundDown(double v)
+{
+  float f = static_cast<float>(v);
+  if (static_cast<double>(f) > v)
+    f = std::nextafter(f, -std::numeric_limits<float>::infinity());
+  return f;
+}
+float roundUp(double v)
+{
+  float f = static_cast<float>(v);
+  if (static_cast<double>(f) < v)
+    f = std::nextafter(f, std::numeric_limits<float>::infinity());
+  return f;
+}
+} // namespace
+
+// Asks the memory for a child's data as soon as it is pushed, so that the miss overlaps the work
+// on the entries above it (the tree of a large scan does not fit in the caches, and the queries
+// of the simplification come in no spatial order).
+inline void TriangleTree::prefetch(const Ref& r) const
+{
+#if defined(__GNUC__)
+  if (r.Count == 0)
+  {
+    __builtin_prefetch(&QueryNodes[static_cast<std::size_t>(r.Child)]);
+  }
+  else
+  {
+    const char* first = reinterpret_cast<const char*>(&Tri[static_cast<std::size_t>(r.Child)]);
+    const std::size_t bytes = sizeof(Tri3) * static_cast<std::size_t>(std::min(r.Count, 4));
+    for (std::size_t b = 0; b < bytes; b += 64)
+      __builtin_prefetch(first + b);
+  }
+#else
+  (void)r;
+#endif
+}
+
+void TriangleTree::buildQueryNodes()
+{
+  QueryNodes.clear();
+  // Nodes are in pre-order: numbering the internal ones in index order keeps it (a node's left
+  // child, when internal, is the next query node)
+  std::vector<int> queryIndex(Nodes.size(), -1);
+  int internal = 0;
+  for (std::size_t i = 0; i < Nodes.size(); ++i)
+    if (Nodes[i].Left >= 0)
+      queryIndex[i] = internal++;
+  QueryNodes.resize(static_cast<std::size_t>(internal));
+  auto ref = [&](int node) {
+    const Node& n = Nodes[node];
+    return n.Left >= 0 ? Ref{ queryIndex[node], 0 } : Ref{ n.Start, n.Count };
+  };
+  Root = Nodes.empty() ? Ref{ 0, 0 } : ref(0);
+  tbb::parallel_for(
+    tbb::blocked_range<std::size_t>(0, Nodes.size(), 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t i = r.begin(); i != r.end(); ++i)
+      {
+        const Node& n = Nodes[i];
+        if (n.Left < 0)
+          continue;
+        QueryNode& q = QueryNodes[static_cast<std::size_t>(queryIndex[i])];
+        const int children[2] = { n.Left, n.Right };
+        for (int c = 0; c < 2; ++c)
+        {
+          const Node& child = Nodes[children[c]];
+          for (int a = 0; a < 3; ++a)
+          {
+            q.Lo[c][a] = roundDown(child.Lo[a]);
+            q.Hi[c][a] = roundUp(child.Hi[a]);
+          }
+          const Ref r2 = ref(children[c]);
+          q.Child[c] = r2.Child;
+          q.Count[c] = r2.Count;
+        }
+      }
+    });
 }
 
 void TriangleTree::buildNode(int index, int start, int count, std::vector<BuildItem>& items,
@@ -338,16 +424,15 @@ bool TriangleTree::closestPoint(const Vec3& p, double maxDistance, Vec3& closest
   }
   double best2 = maxDistance < 0 ? std::numeric_limits<double>::infinity() : maxDistance * maxDistance;
   // Each entry keeps its box distance, measured when its parent was opened: popped nodes are
-  // tested against the current best without measuring again (the same nodes are visited, in the
-  // same order, as when each box was measured on popping).
+  // tested against the current best without measuring again.
   struct Pending
   {
-    int Node;
+    Ref R;
     double D2;
   };
   Pending stack[128];
   int top = 0;
-  stack[top++] = { 0, boxPointDistance2(Nodes[0].Lo, Nodes[0].Hi, p) };
+  stack[top++] = { Root, boxPointDistance2(Nodes[0].Lo, Nodes[0].Hi, p) };
   while (top)
   {
     const Pending e = stack[--top];
@@ -355,10 +440,9 @@ bool TriangleTree::closestPoint(const Vec3& p, double maxDistance, Vec3& closest
     {
       continue;
     }
-    const Node& n = Nodes[e.Node];
-    if (n.Left < 0)
+    if (e.R.Count > 0)
     {
-      for (int i = n.Start; i < n.Start + n.Count; ++i)
+      for (int i = e.R.Child; i < e.R.Child + e.R.Count; ++i)
       {
         const Vec3* P = Tri[i].P;
         // the triangle's own box first: nothing in it is nearer than the box (the margin keeps
@@ -383,17 +467,27 @@ bool TriangleTree::closestPoint(const Vec3& p, double maxDistance, Vec3& closest
       continue;
     }
     // visit the nearer child first (pushed last)
-    const double dl = boxPointDistance2(Nodes[n.Left].Lo, Nodes[n.Left].Hi, p);
-    const double dr = boxPointDistance2(Nodes[n.Right].Lo, Nodes[n.Right].Hi, p);
+    const QueryNode& n = QueryNodes[static_cast<std::size_t>(e.R.Child)];
+    const double dl = boxPointDistance2(childLo(n, 0), childHi(n, 0), p);
+    const double dr = boxPointDistance2(childLo(n, 1), childHi(n, 1), p);
+    const Pending left{ { n.Child[0], n.Count[0] }, dl }, right{ { n.Child[1], n.Count[1] }, dr };
+    if (dl <= best2)
+      this->prefetch(left.R);
+    if (dr <= best2)
+      this->prefetch(right.R);
     if (dl < dr)
     {
-      stack[top++] = { n.Right, dr };
-      stack[top++] = { n.Left, dl };
+      if (dr <= best2)
+        stack[top++] = right;
+      if (dl <= best2)
+        stack[top++] = left;
     }
     else
     {
-      stack[top++] = { n.Left, dl };
-      stack[top++] = { n.Right, dr };
+      if (dl <= best2)
+        stack[top++] = left;
+      if (dr <= best2)
+        stack[top++] = right;
     }
   }
   if (triangle < 0)
@@ -465,24 +559,44 @@ double TriangleTree::triangleQuery(const Vec3 t[3], double limit, bool stopAtFir
     return std::max(0.0, gap);
   };
   double best = limit;
-  int stack[128];
+  // Each entry keeps its two lower bounds (box distance squared, plane gap), measured when its
+  // parent was opened and tested again when popped, as `best` may have shrunk meanwhile.
+  struct Pending
+  {
+    Ref R;
+    double Box2;
+    double Gap;
+  };
+  auto far = [&best](double box2, double gap) { return box2 >= best * best || gap >= best; };
+  Pending stack[128];
   int top = 0;
-  stack[top++] = 0;
+  stack[top++] = { Root, boxBoxDistance2(Nodes[0].Lo, Nodes[0].Hi, tlo, thi), planeGap(Nodes[0].Lo, Nodes[0].Hi) };
   while (top)
   {
-    const Node& n = Nodes[stack[--top]];
-    const double lb2 = boxBoxDistance2(n.Lo, n.Hi, tlo, thi);
-    if (lb2 >= best * best || planeGap(n.Lo, n.Hi) >= best)
+    const Pending e = stack[--top];
+    if (far(e.Box2, e.Gap))
     {
       continue;
     }
-    if (n.Left >= 0)
+    if (e.R.Count == 0)
     {
-      stack[top++] = n.Left;
-      stack[top++] = n.Right;
+      const QueryNode& n = QueryNodes[static_cast<std::size_t>(e.R.Child)];
+      for (int c = 0; c < 2; ++c)
+      {
+        const Vec3 lo = childLo(n, c), hi = childHi(n, c);
+        const double box2 = boxBoxDistance2(lo, hi, tlo, thi);
+        if (box2 >= best * best)
+          continue;
+        const double gap = planeGap(lo, hi);
+        if (gap < best)
+        {
+          stack[top++] = { { n.Child[c], n.Count[c] }, box2, gap };
+          this->prefetch(stack[top - 1].R);
+        }
+      }
       continue;
     }
-    for (int i = n.Start; i < n.Start + n.Count; ++i)
+    for (int i = e.R.Child; i < e.R.Child + e.R.Count; ++i)
     {
       const Tri3& o = Tri[i];
       // a piece whose box is beyond the limit: the triangle's nearest point lies in another piece
@@ -551,23 +665,24 @@ long long TriangleTree::countWithin(const Vec3 t[3], double delta) const
   const Vec3 thi = t[0].cwiseMax(t[1]).cwiseMax(t[2]);
   long long count = 0;
   std::vector<int> ids; // with pieces: a triangle counts once
-  int stack[128];
+  Ref stack[128];
   int top = 0;
-  stack[top++] = 0;
+  if (!(boxBoxDistance2(Nodes[0].Lo, Nodes[0].Hi, tlo, thi) > delta * delta))
+  {
+    stack[top++] = Root;
+  }
   while (top)
   {
-    const Node& n = Nodes[stack[--top]];
-    if (boxBoxDistance2(n.Lo, n.Hi, tlo, thi) > delta * delta)
+    const Ref r = stack[--top];
+    if (r.Count == 0)
     {
+      const QueryNode& n = QueryNodes[static_cast<std::size_t>(r.Child)];
+      for (int c = 0; c < 2; ++c)
+        if (!(boxBoxDistance2(childLo(n, c), childHi(n, c), tlo, thi) > delta * delta))
+          stack[top++] = { n.Child[c], n.Count[c] };
       continue;
     }
-    if (n.Left >= 0)
-    {
-      stack[top++] = n.Left;
-      stack[top++] = n.Right;
-      continue;
-    }
-    for (int i = n.Start; i < n.Start + n.Count; ++i)
+    for (int i = r.Child; i < r.Child + r.Count; ++i)
     {
       if (!Pieces.empty() && boxBoxDistance2(Pieces[i].Lo, Pieces[i].Hi, tlo, thi) > delta * delta)
       {

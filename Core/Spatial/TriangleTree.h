@@ -101,7 +101,32 @@ private:
     double Area = 0.0;
     double Radius = 0.0; // farthest triangle corner from Center
   };
+  // The layout the distance queries walk (built from Nodes after the build): each internal node
+  // holds both children's boxes, in floats rounded outward, so that choosing and pruning children
+  // reads one 64-byte line instead of three nodes of Nodes, and a pushed child is prefetched. The
+  // same nodes are visited in the same order as with Nodes (rounding outward only prunes less).
+  // Measured with sdfcage_simplify_benchmark (best of 4) on dragon_vrip.ply, whose 871k-face tree
+  // outgrows the caches: the simplification 4.63 -> 4.23 s. A child is an internal node (Count 0:
+  // Child is its index here) or a leaf (Child its first entry in Tri, Count its entries).
+  struct alignas(64) QueryNode
+  {
+    float Lo[2][3];
+    float Hi[2][3];
+    int Child[2];
+    int Count[2];
+  };
+  struct Ref
+  {
+    int Child;
+    int Count;
+  };
+  void buildQueryNodes();
+  void prefetch(const Ref& r) const;
+  Vec3 childLo(const QueryNode& q, int c) const { return Vec3(q.Lo[c][0], q.Lo[c][1], q.Lo[c][2]); }
+  Vec3 childHi(const QueryNode& q, int c) const { return Vec3(q.Hi[c][0], q.Hi[c][1], q.Hi[c][2]); }
   std::vector<Node> Nodes;
+  std::vector<QueryNode> QueryNodes;
+  Ref Root{ 0, 0 }; // the root as a child reference (a leaf when the tree has one node)
   std::vector<Dipole> Dipoles;
   std::vector<Tri3> Tri;
   std::vector<Piece> Pieces; // parallel to Tri when some triangle was split, else empty
