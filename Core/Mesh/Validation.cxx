@@ -5,10 +5,15 @@
 #include "Spatial/Geometry.h"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <numeric>
 #include <sstream>
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_reduce.h>
 
 namespace sdfcage
 {
@@ -448,57 +453,67 @@ bool checkTopology(const TriangleMesh& mesh, MeshDefects& d, Progress* progress 
       incident[fill[i]++] = static_cast<int>(f);
     }
   }
-  std::vector<int> parent;
-  std::vector<std::pair<int, int>> neighbourFace; // (other vertex, local triangle index)
-  for (std::size_t v = 0; v < nv; ++v)
-  {
-    if (v % CheckEvery == 0 && progressCancelled(progress))
-      return false;
-    const int n = start[v + 1] - start[v];
-    if (n == 0)
-    {
-      continue;
-    }
-    parent.resize(n);
-    std::iota(parent.begin(), parent.end(), 0);
-    neighbourFace.clear();
-    for (int k = 0; k < n; ++k)
-    {
-      const Triangle& t = mesh.Triangles[incident[start[v] + k]];
-      for (int i : t)
+  // the vertices in parallel ranges, each with its own scratch (the count is a sum)
+  std::atomic<bool> stopped{ false };
+  d.NonManifoldVertices += tbb::parallel_reduce(
+    tbb::blocked_range<std::size_t>(0, nv, 4096), std::int64_t(0),
+    [&](const tbb::blocked_range<std::size_t>& r, std::int64_t count) {
+      if (stopped || progressCancelled(progress))
       {
-        if (i != static_cast<int>(v))
+        stopped = true;
+        return count;
+      }
+      std::vector<int> parent;
+      std::vector<std::pair<int, int>> neighbourFace; // (other vertex, local triangle index)
+      for (std::size_t v = r.begin(); v != r.end(); ++v)
+      {
+        const int n = start[v + 1] - start[v];
+        if (n == 0)
         {
-          neighbourFace.emplace_back(i, k);
+          continue;
         }
+        parent.resize(n);
+        std::iota(parent.begin(), parent.end(), 0);
+        neighbourFace.clear();
+        for (int k = 0; k < n; ++k)
+        {
+          const Triangle& t = mesh.Triangles[incident[start[v] + k]];
+          for (int i : t)
+          {
+            if (i != static_cast<int>(v))
+            {
+              neighbourFace.emplace_back(i, k);
+            }
+          }
+        }
+        std::sort(neighbourFace.begin(), neighbourFace.end());
+        auto root = [&](int x) {
+          while (parent[x] != x)
+          {
+            parent[x] = parent[parent[x]];
+            x = parent[x];
+          }
+          return x;
+        };
+        for (std::size_t i = 1; i < neighbourFace.size(); ++i)
+        {
+          if (neighbourFace[i].first == neighbourFace[i - 1].first)
+          {
+            parent[root(neighbourFace[i].second)] = root(neighbourFace[i - 1].second);
+          }
+        }
+        int fans = 0;
+        for (int k = 0; k < n; ++k)
+        {
+          fans += root(k) == k;
+        }
+        count += fans > 1 ? 1 : 0;
       }
-    }
-    std::sort(neighbourFace.begin(), neighbourFace.end());
-    auto root = [&](int x) {
-      while (parent[x] != x)
-      {
-        parent[x] = parent[parent[x]];
-        x = parent[x];
-      }
-      return x;
-    };
-    for (std::size_t i = 1; i < neighbourFace.size(); ++i)
-    {
-      if (neighbourFace[i].first == neighbourFace[i - 1].first)
-      {
-        parent[root(neighbourFace[i].second)] = root(neighbourFace[i - 1].second);
-      }
-    }
-    int fans = 0;
-    for (int k = 0; k < n; ++k)
-    {
-      fans += root(k) == k;
-    }
-    if (fans > 1)
-    {
-      ++d.NonManifoldVertices;
-    }
-  }
+      return count;
+    },
+    std::plus<std::int64_t>());
+  if (stopped)
+    return false;
   return true;
 }
 } // namespace
