@@ -1,6 +1,5 @@
 #include "Envelope/ActivePoints.h"
 
-#include "Common/CancellableSort.h"
 #include "Common/Progress.h"
 
 #include <tbb/blocked_range.h>
@@ -147,30 +146,69 @@ struct EdgeGraph
   /// to drop.
   explicit EdgeGraph(const TriangleMesh& mesh, Progress* progress = nullptr)
   {
+    // Per point, in parallel: its neighbours (the other corners of its triangles) sorted and
+    // unique, which is the order a global sort of the edges gave (2.6M edges of dragon_vrip:
+    // 0.2 s serial before). The triangles of each point first, as a CSR.
     const std::size_t n = mesh.Points.size();
-    std::vector<std::pair<int, int>> edges;
-    edges.reserve(mesh.Triangles.size() * 3);
+    std::vector<std::size_t> first(n + 1, 0);
     for (const Triangle& t : mesh.Triangles)
     {
       for (int k = 0; k < 3; ++k)
       {
-        const int a = t[k], b = t[(k + 1) % 3];
-        if (a != b)
+        ++first[t[k] + 1];
+      }
+    }
+    for (std::size_t i = 0; i < n; ++i)
+    {
+      first[i + 1] += first[i];
+    }
+    std::vector<int> incident(first[n]);
+    {
+      std::vector<std::size_t> fill(first.begin(), first.end() - 1);
+      for (std::size_t f = 0; f < mesh.Triangles.size(); ++f)
+      {
+        for (int k = 0; k < 3; ++k)
         {
-          edges.emplace_back(std::min(a, b), std::max(a, b));
+          incident[fill[mesh.Triangles[f][k]]++] = static_cast<int>(f);
         }
       }
     }
-    if (!cancellableSort(edges, progress))
-    {
-      edges.clear();
-    }
-    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+    // a triangle listing a point twice lists it once here too
+    auto neighbours = [&](std::size_t v, std::vector<int>& out) {
+      out.clear();
+      for (std::size_t i = first[v]; i < first[v + 1]; ++i)
+      {
+        for (int u : mesh.Triangles[incident[i]])
+        {
+          if (u != static_cast<int>(v))
+          {
+            out.push_back(u);
+          }
+        }
+      }
+      std::sort(out.begin(), out.end());
+      out.erase(std::unique(out.begin(), out.end()), out.end());
+    };
+    std::atomic<bool> stopped{ false };
+    const tbb::blocked_range<std::size_t> all(0, n, 4096);
     Start.assign(n + 1, 0);
-    for (const auto& e : edges)
+    tbb::parallel_for(all, [&](const tbb::blocked_range<std::size_t>& r) {
+      if (stopped || progressCancelled(progress))
+      {
+        stopped = true;
+        return;
+      }
+      std::vector<int> out;
+      for (std::size_t v = r.begin(); v != r.end(); ++v)
+      {
+        neighbours(v, out);
+        Start[v + 1] = out.size();
+      }
+    });
+    if (stopped)
     {
-      ++Start[e.first + 1];
-      ++Start[e.second + 1];
+      Start.assign(n + 1, 0);
+      return; // incomplete: the caller drops it
     }
     for (std::size_t i = 0; i < n; ++i)
     {
@@ -178,15 +216,21 @@ struct EdgeGraph
     }
     Neighbor.resize(Start[n]);
     Length.resize(Start[n]);
-    std::vector<std::size_t> fill(Start.begin(), Start.end() - 1);
-    for (const auto& e : edges)
-    {
-      const double len = (mesh.Points[e.first] - mesh.Points[e.second]).norm();
-      Neighbor[fill[e.first]] = e.second;
-      Length[fill[e.first]++] = len;
-      Neighbor[fill[e.second]] = e.first;
-      Length[fill[e.second]++] = len;
-    }
+    tbb::parallel_for(all, [&](const tbb::blocked_range<std::size_t>& r) {
+      std::vector<int> out;
+      for (std::size_t v = r.begin(); v != r.end(); ++v)
+      {
+        neighbours(v, out);
+        std::size_t at = Start[v];
+        for (int u : out)
+        {
+          // measured from the lower id, as for the edge itself: both ends read the same length
+          const int a = std::min(u, static_cast<int>(v)), b = std::max(u, static_cast<int>(v));
+          Neighbor[at] = u;
+          Length[at++] = (mesh.Points[a] - mesh.Points[b]).norm();
+        }
+      }
+    });
   }
 };
 

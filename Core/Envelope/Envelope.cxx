@@ -576,7 +576,12 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
       result.GapSites.push_back(active.Surface.Points[id]);
     }
     amplification = &active;
-    if (!active.empty())
+    // the refined surface's own tree, unless the refinement split nothing: the surface is then
+    // the input itself (the same points and triangles in the same order), whose tree is being
+    // built anyway (dragon_vrip: one 871k-triangle build fewer)
+    if (!active.empty() &&
+      !(active.Surface.Points.size() == unitInput.Points.size() &&
+        active.Surface.Triangles.size() == unitInput.Triangles.size()))
     {
       surfaceTree = std::make_unique<TriangleTree>(active.Surface);
     }
@@ -659,9 +664,10 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
           return true; // stops the extraction; buildEnvelope reports TooComplex
         }
       }
-      if (amplification && surfaceTree)
+      if (amplification && !amplification->empty())
       {
-        result.ProjectedVertices = projectOntoAmplifiedOffset(envelope, *amplification, *surfaceTree, c, 0.5 * h);
+        result.ProjectedVertices =
+          projectOntoAmplifiedOffset(envelope, *amplification, surfaceTree ? *surfaceTree : tree(), c, 0.5 * h);
       }
       result.IsosurfaceSeconds += seconds(t0);
       progressStage(progress, "verifying enclosure", 0.7 * progressEnd, progressEnd);
