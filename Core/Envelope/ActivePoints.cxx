@@ -148,37 +148,15 @@ struct EdgeGraph
   {
     // Per point, in parallel: its neighbours (the other corners of its triangles) sorted and
     // unique, which is the order a global sort of the edges gave (2.6M edges of dragon_vrip:
-    // 0.2 s serial before). The triangles of each point first, as a CSR.
+    // 0.2 s serial before).
     const std::size_t n = mesh.Points.size();
-    std::vector<std::size_t> first(n + 1, 0);
-    for (const Triangle& t : mesh.Triangles)
-    {
-      for (int k = 0; k < 3; ++k)
-      {
-        ++first[t[k] + 1];
-      }
-    }
-    for (std::size_t i = 0; i < n; ++i)
-    {
-      first[i + 1] += first[i];
-    }
-    std::vector<int> incident(first[n]);
-    {
-      std::vector<std::size_t> fill(first.begin(), first.end() - 1);
-      for (std::size_t f = 0; f < mesh.Triangles.size(); ++f)
-      {
-        for (int k = 0; k < 3; ++k)
-        {
-          incident[fill[mesh.Triangles[f][k]]++] = static_cast<int>(f);
-        }
-      }
-    }
+    const PointTriangles incident(mesh);
     // a triangle listing a point twice lists it once here too
     auto neighbours = [&](std::size_t v, std::vector<int>& out) {
       out.clear();
-      for (std::size_t i = first[v]; i < first[v + 1]; ++i)
+      for (std::size_t i = incident.First[v]; i < incident.First[v + 1]; ++i)
       {
-        for (int u : mesh.Triangles[incident[i]])
+        for (int u : mesh.Triangles[incident.Triangles[i]])
         {
           if (u != static_cast<int>(v))
           {

@@ -43,6 +43,20 @@ int findRoot(std::vector<int>& parent, int i)
 }
 } // namespace
 
+PointTriangles::PointTriangles(const TriangleMesh& mesh)
+  : First(mesh.Points.size() + 1, 0)
+{
+  for (const Triangle& t : mesh.Triangles)
+    for (int v : t)
+      ++First[v + 1];
+  std::partial_sum(First.begin(), First.end(), First.begin());
+  Triangles.resize(First.back());
+  std::vector<std::size_t> fill(First.begin(), First.end() - 1);
+  for (std::size_t f = 0; f < mesh.Triangles.size(); ++f)
+    for (int v : mesh.Triangles[f])
+      Triangles[fill[v]++] = static_cast<int>(f);
+}
+
 int triangleComponents(const TriangleMesh& mesh, std::vector<int>& componentOfTriangle)
 {
   std::vector<int> parent(mesh.Points.size());

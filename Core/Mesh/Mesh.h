@@ -51,6 +51,16 @@ double signedVolume(const TriangleMesh& mesh);
 /// number of components.
 int triangleComponents(const TriangleMesh& mesh, std::vector<int>& componentOfTriangle);
 
+/// The triangles at each point, as a CSR: those of point v are Triangles[First[v] .. First[v + 1]),
+/// in increasing order (a triangle naming v twice is listed twice).
+struct PointTriangles
+{
+  std::vector<std::size_t> First;
+  std::vector<int> Triangles;
+  explicit PointTriangles(const TriangleMesh& mesh);
+  std::size_t count(std::size_t v) const { return First[v + 1] - First[v]; }
+};
+
 /// One input point per connected component (the first corner of its first triangle): a surface
 /// that keeps away from the input has each component wholly inside or wholly outside, so these
 /// points decide enclosure (verification) and must never be swept across (simplification).

@@ -435,24 +435,7 @@ bool checkTopology(const TriangleMesh& mesh, MeshDefects& d, Progress* progress 
   // Vertex manifoldness: the triangles around a vertex, linked through shared edges, must form one
   // fan. Count fans per vertex with a small union-find over the vertex's incident triangles.
   const std::size_t nv = mesh.Points.size();
-  std::vector<int> start(nv + 1, 0);
-  for (const Triangle& t : mesh.Triangles)
-  {
-    for (int i : t)
-    {
-      ++start[i + 1];
-    }
-  }
-  std::partial_sum(start.begin(), start.end(), start.begin());
-  std::vector<int> incident(start[nv]);
-  std::vector<int> fill(start.begin(), start.end() - 1);
-  for (std::size_t f = 0; f < nf; ++f)
-  {
-    for (int i : mesh.Triangles[f])
-    {
-      incident[fill[i]++] = static_cast<int>(f);
-    }
-  }
+  const PointTriangles incident(mesh);
   // the vertices in parallel ranges, each with its own scratch (the count is a sum)
   std::atomic<bool> stopped{ false };
   d.NonManifoldVertices += tbb::parallel_reduce(
@@ -467,7 +450,7 @@ bool checkTopology(const TriangleMesh& mesh, MeshDefects& d, Progress* progress 
       std::vector<std::pair<int, int>> neighbourFace; // (other vertex, local triangle index)
       for (std::size_t v = r.begin(); v != r.end(); ++v)
       {
-        const int n = start[v + 1] - start[v];
+        const int n = static_cast<int>(incident.count(v));
         if (n == 0)
         {
           continue;
@@ -477,7 +460,7 @@ bool checkTopology(const TriangleMesh& mesh, MeshDefects& d, Progress* progress 
         neighbourFace.clear();
         for (int k = 0; k < n; ++k)
         {
-          const Triangle& t = mesh.Triangles[incident[start[v] + k]];
+          const Triangle& t = mesh.Triangles[incident.Triangles[incident.First[v] + k]];
           for (int i : t)
           {
             if (i != static_cast<int>(v))
@@ -512,9 +495,7 @@ bool checkTopology(const TriangleMesh& mesh, MeshDefects& d, Progress* progress 
       return count;
     },
     std::plus<std::int64_t>());
-  if (stopped)
-    return false;
-  return true;
+  return !stopped;
 }
 } // namespace
 

@@ -471,24 +471,12 @@ bool TriangleTree::closestPoint(const Vec3& p, double maxDistance, Vec3& closest
     const double dl = boxPointDistance2(childLo(n, 0), childHi(n, 0), p);
     const double dr = boxPointDistance2(childLo(n, 1), childHi(n, 1), p);
     const Pending left{ { n.Child[0], n.Count[0] }, dl }, right{ { n.Child[1], n.Count[1] }, dr };
-    if (dl <= best2)
-      this->prefetch(left.R);
-    if (dr <= best2)
-      this->prefetch(right.R);
-    if (dl < dr)
-    {
-      if (dr <= best2)
-        stack[top++] = right;
-      if (dl <= best2)
-        stack[top++] = left;
-    }
-    else
-    {
-      if (dl <= best2)
-        stack[top++] = left;
-      if (dr <= best2)
-        stack[top++] = right;
-    }
+    for (const Pending& q : { dl < dr ? right : left, dl < dr ? left : right })
+      if (q.D2 <= best2)
+      {
+        this->prefetch(q.R);
+        stack[top++] = q;
+      }
   }
   if (triangle < 0)
   {
