@@ -1,5 +1,7 @@
 #include "SDFCageVTKConversion.h"
 
+#include "Common/LargePages.h"
+
 #include "vtkCellArray.h"
 #include "vtkCellArrayIterator.h"
 #include "vtkDoubleArray.h"
@@ -136,6 +138,8 @@ void AppendCells(vtkCellArray* cells, CellKind kind, sdfcage::PolygonMesh& mesh)
 void ToPolygonMesh(vtkPolyData* input, sdfcage::PolygonMesh& mesh)
 {
   const vtkIdType numberOfPoints = input->GetNumberOfPoints();
+  mesh.Points.clear();
+  sdfcage::ReserveLarge(mesh.Points, static_cast<std::size_t>(numberOfPoints));
   mesh.Points.resize(static_cast<std::size_t>(numberOfPoints));
   double p[3];
   for (vtkIdType i = 0; i < numberOfPoints; ++i)
@@ -147,8 +151,8 @@ void ToPolygonMesh(vtkPolyData* input, sdfcage::PolygonMesh& mesh)
   mesh.Connectivity.clear();
   if (vtkCellArray* polys = input->GetPolys())
   {
-    mesh.Connectivity.reserve(static_cast<std::size_t>(polys->GetNumberOfConnectivityIds()));
-    mesh.Offsets.reserve(static_cast<std::size_t>(polys->GetNumberOfCells()) + 1);
+    sdfcage::ReserveLarge(mesh.Connectivity, static_cast<std::size_t>(polys->GetNumberOfConnectivityIds()));
+    sdfcage::ReserveLarge(mesh.Offsets, static_cast<std::size_t>(polys->GetNumberOfCells()) + 1);
   }
   AppendCells(input->GetPolys(), CellKind::Polygon, mesh);
   AppendCells(input->GetStrips(), CellKind::Strip, mesh);

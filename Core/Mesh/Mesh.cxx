@@ -1,5 +1,7 @@
 #include "Mesh/Mesh.h"
 
+#include "Common/LargePages.h"
+
 #include <algorithm>
 #include <numeric>
 #include <unordered_map>
@@ -50,6 +52,7 @@ PointTriangles::PointTriangles(const TriangleMesh& mesh)
     for (int v : t)
       ++First[v + 1];
   std::partial_sum(First.begin(), First.end(), First.begin());
+  ReserveLarge(Triangles, First.back());
   Triangles.resize(First.back());
   std::vector<std::size_t> fill(First.begin(), First.end() - 1);
   for (std::size_t f = 0; f < mesh.Triangles.size(); ++f)

@@ -1,6 +1,7 @@
 #include "Mesh/Validation.h"
 
 #include "Common/CancellableSort.h"
+#include "Common/LargePages.h"
 #include "Common/Progress.h"
 #include "Spatial/Geometry.h"
 
@@ -304,8 +305,11 @@ std::int64_t mergeCoincidentPoints(const std::vector<Vec3>& pts, const std::vect
       std::size_t size = 16;
       while (size < 2 * capacity)
         size *= 2;
+      ReserveLarge(Keys, size);
       Keys.assign(size, 0);
+      ReserveLarge(Head, size);
       Head.assign(size, -1);
+      ReserveLarge(Tail, size);
       Tail.assign(size, -1);
       Mask = size - 1;
     }
@@ -395,7 +399,7 @@ bool checkTopology(const TriangleMesh& mesh, MeshDefects& d, Progress* progress 
 {
   const std::size_t nf = mesh.Triangles.size();
   std::vector<HalfEdge> he;
-  he.reserve(3 * nf);
+  ReserveLarge(he, 3 * nf);
   for (std::size_t f = 0; f < nf; ++f)
   {
     const Triangle& t = mesh.Triangles[f];
@@ -666,7 +670,7 @@ MeshDefects prepareMesh(
 
   // 3. cells -> triangles: convex planar polygons by a fan (as before), others by ear clipping
   // in their plane, a fan when even that fails (a self-overlapping outline)
-  output.Triangles.reserve(nc);
+  ReserveLarge(output.Triangles, nc);
   std::vector<std::int64_t> ring;
   for (std::size_t c = 0; c < nc; ++c)
   {

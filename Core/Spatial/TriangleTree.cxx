@@ -1,5 +1,6 @@
 #include "Spatial/TriangleTree.h"
 
+#include "Common/LargePages.h"
 #include "Common/Progress.h"
 #include "Spatial/Geometry.h"
 
@@ -153,7 +154,11 @@ bool TriangleTree::build(const TriangleMesh& mesh, Progress* progress, bool spli
   {
     return !progressCancelled(progress);
   }
-  std::vector<Tri3> tri(n);
+  // The large arrays are filled right after they are made: huge pages spare most of their page
+  // faults (Common/LargePages.h). Tri3 entries are made once, in the tree's order, after the
+  // build: the build itself reads the corners from the mesh (a whole copy of the triangles before
+  // the build, then a second one in the tree's order, faulted 140 MB on an 871k-face scan).
+  ReserveLarge(Normals, n);
   Normals.resize(n);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
     if (progressCancelled(progress))
@@ -161,29 +166,39 @@ bool TriangleTree::build(const TriangleMesh& mesh, Progress* progress, bool spli
     for (std::size_t f = r.begin(); f != r.end(); ++f)
     {
       const Triangle& t = mesh.Triangles[f];
-      for (int k = 0; k < 3; ++k)
-      {
-        tri[f].P[k] = mesh.Points[t[k]];
-      }
-      tri[f].Id = static_cast<int>(f);
-      const Vec3 nrm = (tri[f].P[1] - tri[f].P[0]).cross(tri[f].P[2] - tri[f].P[0]);
+      const Vec3& a = mesh.Points[t[0]];
+      const Vec3 nrm = (mesh.Points[t[1]] - a).cross(mesh.Points[t[2]] - a);
       Normals[f] = nrm.norm() > 0 ? Vec3(nrm.normalized()) : Vec3(Vec3::Zero());
     }
   });
+  auto wholeTriangle = [&mesh](std::size_t f) {
+    Tri3 e;
+    const Triangle& t = mesh.Triangles[f];
+    for (int k = 0; k < 3; ++k)
+    {
+      e.P[k] = mesh.Points[t[k]];
+    }
+    e.Id = static_cast<int>(f);
+    return e;
+  };
   // the pieces of long triangles: counted first (the length grows until they fit), then made
   std::vector<std::size_t> first; // entries of triangle f: [first[f], first[f + 1])
   const double length2 = splitLong && !progressCancelled(progress) ? pieceLayout(mesh, first) : 0.0;
   const std::size_t m = first.empty() ? n : first[n];
-  std::vector<Tri3> entries;
+  std::vector<Tri3> entries; // per entry when triangles are split (else the corners come from the mesh)
   std::vector<Piece> pieces;
-  std::vector<BuildItem> items(m);
+  std::vector<BuildItem> items;
+  ReserveLarge(items, m);
+  items.resize(m);
   if (first.empty())
   {
-    entries = std::move(tri);
-    for (std::size_t f = 0; f < n; ++f)
-    {
-      items[f] = { (entries[f].P[0] + entries[f].P[1] + entries[f].P[2]) / 3.0, static_cast<int>(f) };
-    }
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t f = r.begin(); f != r.end(); ++f)
+      {
+        const Triangle& t = mesh.Triangles[f];
+        items[f] = { (mesh.Points[t[0]] + mesh.Points[t[1]] + mesh.Points[t[2]]) / 3.0, static_cast<int>(f) };
+      }
+    });
   }
   else
   {
@@ -194,12 +209,13 @@ bool TriangleTree::build(const TriangleMesh& mesh, Progress* progress, bool spli
         return;
       for (std::size_t f = r.begin(); f != r.end(); ++f)
       {
-        const Vec3* P = tri[f].P;
+        const Tri3 whole = wholeTriangle(f);
+        const Vec3* P = whole.P;
         const double pad = 1e-9 * std::sqrt(std::max(
           { (P[1] - P[0]).squaredNorm(), (P[2] - P[1]).squaredNorm(), (P[0] - P[2]).squaredNorm() }));
         std::size_t e = first[f];
         auto emit = [&](const Vec3& a, const Vec3& b, const Vec3& c) {
-          entries[e] = tri[f];
+          entries[e] = whole;
           Piece& q = pieces[e];
           q.P[0] = a;
           q.P[1] = b;
@@ -225,10 +241,12 @@ bool TriangleTree::build(const TriangleMesh& mesh, Progress* progress, bool spli
   }
   // The node layout is fixed in advance (pre-order, sizes known from the counts), so subtrees
   // are built in parallel into their own ranges and the tree does not depend on the threads.
-  Nodes.resize(static_cast<std::size_t>(subtreeNodes(static_cast<int>(m), 0)));
+  const std::size_t nodeCount = static_cast<std::size_t>(subtreeNodes(static_cast<int>(m), 0));
+  ReserveLarge(Nodes, nodeCount);
+  Nodes.resize(nodeCount);
   if (!progressCancelled(progress))
   {
-    buildNode(0, 0, static_cast<int>(m), items, entries, pieces, 0, progress);
+    buildNode(0, 0, static_cast<int>(m), items, mesh, pieces, 0, progress);
   }
   if (progressCancelled(progress))
   {
@@ -238,11 +256,15 @@ bool TriangleTree::build(const TriangleMesh& mesh, Progress* progress, bool spli
     SplitTriangles = 0;
     return false;
   }
+  ReserveLarge(Tri, m);
   Tri.resize(m);
-  for (std::size_t i = 0; i < m; ++i)
-  {
-    Tri[i] = entries[items[i].Id];
-  }
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, m, 4096), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i != r.end(); ++i)
+    {
+      const std::size_t id = static_cast<std::size_t>(items[i].Id);
+      Tri[i] = entries.empty() ? wholeTriangle(id) : entries[id];
+    }
+  });
   if (!pieces.empty())
   {
     Pieces.resize(m);
@@ -306,6 +328,7 @@ void TriangleTree::buildQueryNodes()
   for (std::size_t i = 0; i < Nodes.size(); ++i)
     if (Nodes[i].Left >= 0)
       queryIndex[i] = internal++;
+  ReserveLarge(QueryNodes, static_cast<std::size_t>(internal));
   QueryNodes.resize(static_cast<std::size_t>(internal));
   auto ref = [&](int node) {
     const Node& n = Nodes[node];
@@ -337,8 +360,8 @@ void TriangleTree::buildQueryNodes()
     });
 }
 
-void TriangleTree::buildNode(int index, int start, int count, std::vector<BuildItem>& items,
-  const std::vector<Tri3>& tri, const std::vector<Piece>& pieces, int depth, Progress* progress)
+void TriangleTree::buildNode(int index, int start, int count, std::vector<BuildItem>& items, const TriangleMesh& mesh,
+  const std::vector<Piece>& pieces, int depth, Progress* progress)
 {
   if (count > 8192 && progressCancelled(progress))
   {
@@ -356,10 +379,10 @@ void TriangleTree::buildNode(int index, int start, int count, std::vector<BuildI
         hi = hi.cwiseMax(pieces[items[i].Id].Hi);
         continue;
       }
-      for (const Vec3& p : tri[items[i].Id].P)
+      for (const int corner : mesh.Triangles[static_cast<std::size_t>(items[i].Id)])
       {
-        lo = lo.cwiseMin(p);
-        hi = hi.cwiseMax(p);
+        lo = lo.cwiseMin(mesh.Points[static_cast<std::size_t>(corner)]);
+        hi = hi.cwiseMax(mesh.Points[static_cast<std::size_t>(corner)]);
       }
     }
     node.Lo = lo;
@@ -387,8 +410,8 @@ void TriangleTree::buildNode(int index, int start, int count, std::vector<BuildI
   const int right = left + subtreeNodes(half, depth + 1);
   node.Left = left;
   node.Right = right;
-  auto buildLeft = [&] { buildNode(left, start, half, items, tri, pieces, depth + 1, progress); };
-  auto buildRight = [&] { buildNode(right, start + half, count - half, items, tri, pieces, depth + 1, progress); };
+  auto buildLeft = [&] { buildNode(left, start, half, items, mesh, pieces, depth + 1, progress); };
+  auto buildRight = [&] { buildNode(right, start + half, count - half, items, mesh, pieces, depth + 1, progress); };
   if (count > 8192)
   {
     tbb::parallel_invoke(buildLeft, buildRight);

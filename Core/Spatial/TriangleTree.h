@@ -87,7 +87,8 @@ private:
     Vec3 C; // centroid
     int Id;
   };
-  void buildNode(int index, int start, int count, std::vector<BuildItem>& items, const std::vector<Tri3>& tri,
+  // Leaf boxes: the pieces' when triangles are split, else the mesh's triangles by id.
+  void buildNode(int index, int start, int count, std::vector<BuildItem>& items, const TriangleMesh& mesh,
     const std::vector<Piece>& pieces, int depth, Progress* progress);
   // Entries per triangle (first[f] .. first[f + 1]) and the squared piece length; 0 and no
   // entries when no triangle is split.

@@ -4,11 +4,13 @@
 #include "CLIMessages.h"
 #include "CLIParsers.h"
 
-#include "Mesh/Shapes.h" // sdfcage::makeBuiltinShape (Core)
+#include "Common/LargePages.h" // sdfcage::ReserveLarge (Core)
+#include "Mesh/Shapes.h"       // sdfcage::makeBuiltinShape (Core)
 
 #include <vtkCallbackCommand.h>
 #include <vtkCellArray.h>
 #include <vtkDataArraySelection.h>
+#include <vtkDoubleArray.h>
 #include <vtkIdTypeArray.h>
 #include <vtkNew.h>
 #include <vtkOBJWriter.h>
@@ -66,39 +68,55 @@ std::string firstVTKError()
 /// The whole file in memory (the size was checked by the caller).
 bool slurp(const std::string& path, std::string& bytes)
 {
-  std::ifstream in(path, std::ios::binary);
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in)
   {
     return false;
   }
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  bytes = buffer.str();
-  return !in.bad();
+  // sized once and read in one call: a stream buffer grown while reading copied a 34 MB scan
+  // three times and faulted its pages as often
+  const std::streamoff size = in.tellg();
+  if (size < 0 || !in.seekg(0))
+  {
+    std::ifstream stream(path, std::ios::binary); // not seekable (a pipe): read as it comes
+    if (!stream)
+    {
+      return false;
+    }
+    std::ostringstream buffer;
+    buffer << stream.rdbuf();
+    bytes = buffer.str();
+    return !stream.bad();
+  }
+  bytes.clear();
+  sdfcage::ReserveLarge(bytes, static_cast<std::size_t>(size));
+  bytes.resize(static_cast<std::size_t>(size));
+  in.read(bytes.data(), size);
+  return in.gcount() == size;
 }
 
 vtkSmartPointer<vtkPolyData> toPolyData(const ParsedMesh& ply)
 {
+  // the arrays are written through their pointers, right after they are made (huge pages: see
+  // Core/Common/LargePages.h)
+  vtkNew<vtkDoubleArray> coordinates;
+  coordinates->SetNumberOfComponents(3);
+  coordinates->SetNumberOfTuples(static_cast<vtkIdType>(ply.Points.size() / 3));
+  sdfcage::AdviseLargePages(coordinates->GetPointer(0), ply.Points.size() * sizeof(double));
+  std::copy(ply.Points.begin(), ply.Points.begin() + static_cast<std::ptrdiff_t>(ply.Points.size() / 3 * 3),
+    coordinates->GetPointer(0));
   vtkNew<vtkPoints> points;
-  points->SetDataTypeToDouble();
-  const vtkIdType n = static_cast<vtkIdType>(ply.Points.size() / 3);
-  points->SetNumberOfPoints(n);
-  for (vtkIdType i = 0; i < n; ++i)
-  {
-    points->SetPoint(i, ply.Points.data() + 3 * i);
-  }
+  points->SetData(coordinates);
   vtkNew<vtkIdTypeArray> offsets;
   vtkNew<vtkIdTypeArray> connectivity;
   offsets->SetNumberOfValues(static_cast<vtkIdType>(ply.Offsets.size()));
-  for (std::size_t i = 0; i < ply.Offsets.size(); ++i)
-  {
-    offsets->SetValue(static_cast<vtkIdType>(i), static_cast<vtkIdType>(ply.Offsets[i]));
-  }
+  sdfcage::AdviseLargePages(offsets->GetPointer(0), ply.Offsets.size() * sizeof(vtkIdType));
+  std::transform(ply.Offsets.begin(), ply.Offsets.end(), offsets->GetPointer(0),
+    [](std::int64_t v) { return static_cast<vtkIdType>(v); });
   connectivity->SetNumberOfValues(static_cast<vtkIdType>(ply.Connectivity.size()));
-  for (std::size_t i = 0; i < ply.Connectivity.size(); ++i)
-  {
-    connectivity->SetValue(static_cast<vtkIdType>(i), static_cast<vtkIdType>(ply.Connectivity[i]));
-  }
+  sdfcage::AdviseLargePages(connectivity->GetPointer(0), ply.Connectivity.size() * sizeof(vtkIdType));
+  std::transform(ply.Connectivity.begin(), ply.Connectivity.end(), connectivity->GetPointer(0),
+    [](std::int64_t v) { return static_cast<vtkIdType>(v); });
   vtkNew<vtkCellArray> polys;
   polys->SetData(offsets, connectivity);
   vtkSmartPointer<vtkPolyData> mesh = vtkSmartPointer<vtkPolyData>::New();
