@@ -16,6 +16,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <ctime>
 #include <cmath>
@@ -152,10 +153,38 @@ double mips(const Vec3& v, const Vec3& a, const Vec3& b, Vec3* grad)
   return mipsEnergy(v, a, b, grad);
 }
 
-/// The 3-point degree-2 rule on a triangle: barycentric (2/3, 1/6, 1/6) and its rotations,
-/// weight 1/3 each.
-const double SpacingRule[3][3] = { { 2.0 / 3, 1.0 / 6, 1.0 / 6 }, { 1.0 / 6, 2.0 / 3, 1.0 / 6 },
-  { 1.0 / 6, 1.0 / 6, 2.0 / 3 } };
+/// The spacing energy's quadrature: the triangle cut into SpacingCuts^2 equal sub-triangles, the
+/// 3-point degree-2 rule on each (barycentric (2/3, 1/6, 1/6) and its rotations), equal weights.
+/// With the 3-point rule on the whole triangle (SpacingCuts 1) the relocation could not see how
+/// the distance varies across a cage triangle: at 500 vertices, 80-89.5% of the area ended within
+/// h +- 20% of the input at h = 0.03 on 5 of 13 closed meshes; with 4 sub-triangles (12 points)
+/// 89.6-98% (sdfcage_tight_benchmark), for 2.6 times the optimization time (armadillo 3.1 ->
+/// 8.2 s); 9 sub-triangles gained another 0.3-0.6% for twice that time again.
+constexpr int SpacingCuts = 2;
+std::vector<std::array<double, 3>> makeSpacingRule()
+{
+  const int n = SpacingCuts;
+  std::vector<std::array<double, 3>> rule;
+  auto corner = [n](int i, int j) {
+    return std::array<double, 3>{ 1.0 - double(i + j) / n, double(i) / n, double(j) / n };
+  };
+  auto add = [&rule](const std::array<double, 3>& p, const std::array<double, 3>& q, const std::array<double, 3>& r) {
+    const double w[3][3] = { { 2.0 / 3, 1.0 / 6, 1.0 / 6 }, { 1.0 / 6, 2.0 / 3, 1.0 / 6 },
+      { 1.0 / 6, 1.0 / 6, 2.0 / 3 } };
+    for (const auto& k : w)
+      rule.push_back({ k[0] * p[0] + k[1] * q[0] + k[2] * r[0], k[0] * p[1] + k[1] * q[1] + k[2] * r[1],
+        k[0] * p[2] + k[1] * q[2] + k[2] * r[2] });
+  };
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; i + j < n; ++j)
+    {
+      add(corner(i, j), corner(i + 1, j), corner(i, j + 1));
+      if (i + j + 1 < n)
+        add(corner(i + 1, j), corner(i + 1, j + 1), corner(i, j + 1));
+    }
+  return rule;
+}
+const std::vector<std::array<double, 3>> SpacingRule = makeSpacingRule();
 
 /// Spacing energy of triangle (v, a, b): A * mean over the rule of (xi - h)^2, and its gradient
 /// with respect to v (xi is 1-Lipschitz with gradient (x - y)/|x - y| outside the input).
@@ -166,6 +195,7 @@ double spacing(const Vec3& v, const Vec3& a, const Vec3& b, const TriangleTree& 
   const double area = 0.5 * a2;
   double mean = 0.0;
   Vec3 g = Vec3::Zero();
+  const double weight = 1.0 / static_cast<double>(SpacingRule.size());
   for (const auto& w : SpacingRule)
   {
     const Vec3 x = w[0] * v + w[1] * a + w[2] * b;
@@ -174,9 +204,9 @@ double spacing(const Vec3& v, const Vec3& a, const Vec3& b, const TriangleTree& 
     double d;
     if (!tree.closestPoint(x, -1.0, y, tri, d))
       continue;
-    mean += (d - h) * (d - h) / 3.0;
+    mean += (d - h) * (d - h) * weight;
     if (grad && d > 0)
-      g += (2.0 * (d - h) * w[0] / 3.0) * (x - y) / d;
+      g += (2.0 * (d - h) * w[0] * weight) * (x - y) / d;
   }
   if (grad)
   {
