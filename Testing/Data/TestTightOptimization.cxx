@@ -102,42 +102,44 @@ TEST(Tight, Spacing)
   Prepared p;
   if (!prepare(p))
     return;
-  const double h = 0.05;
-  OptimizeOptions o;
-  o.Energy = CageEnergy::Spacing;
-  o.TargetSpacing = h;
-  o.Clearance = CageOptions().Envelope.clearance();
-  const OptimizeResult r = optimizeCageInInputUnits(p.Cage.Cage, p.Input, o);
-  expectGuarantees(p, r, "spacing");
-  // the area fraction within h +- 20% (unit-sphere units): each triangle split into 256, judged
-  // at the sub-triangles' centroids
   const Normalization& n = p.Cage.Normalize;
   const TriangleTree tree(n.toUnit(p.Input));
-  const TriangleMesh unit = n.toUnit(r.Cage);
-  const int k = 16;
-  double in = 0.0, all = 0.0;
-  for (const Triangle& t : unit.Triangles)
+  for (const double h : { 0.05, 0.03 })
   {
-    const Vec3& a = unit.Points[t[0]];
-    const Vec3& b = unit.Points[t[1]];
-    const Vec3& c = unit.Points[t[2]];
-    const double area = 0.5 * (b - a).cross(c - a).norm() / (k * k);
-    for (int i = 0; i < k; ++i)
-      for (int j = 0; i + j < k; ++j)
-        for (int up = 0; up < 2; ++up)
-        {
-          if (up == 1 && i + j + 1 >= k)
-            continue;
-          const double bi = i + (up ? 2.0 : 1.0) / 3, bj = j + (up ? 2.0 : 1.0) / 3;
-          const double d = tree.distance(a + (bi / k) * (b - a) + (bj / k) * (c - a));
-          all += area;
-          if (d >= 0.8 * h && d <= 1.2 * h)
-            in += area;
-        }
+    OptimizeOptions o;
+    o.Energy = CageEnergy::Spacing;
+    o.TargetSpacing = h;
+    o.Clearance = CageOptions().Envelope.clearance();
+    const OptimizeResult r = optimizeCageInInputUnits(p.Cage.Cage, p.Input, o);
+    expectGuarantees(p, r, "spacing");
+    // the area fraction within h +- 20% (unit-sphere units): each triangle split into 256, judged
+    // at the sub-triangles' centroids
+    const TriangleMesh unit = n.toUnit(r.Cage);
+    const int k = 16;
+    double in = 0.0, all = 0.0;
+    for (const Triangle& t : unit.Triangles)
+    {
+      const Vec3& a = unit.Points[t[0]];
+      const Vec3& b = unit.Points[t[1]];
+      const Vec3& c = unit.Points[t[2]];
+      const double area = 0.5 * (b - a).cross(c - a).norm() / (k * k);
+      for (int i = 0; i < k; ++i)
+        for (int j = 0; i + j < k; ++j)
+          for (int up = 0; up < 2; ++up)
+          {
+            if (up == 1 && i + j + 1 >= k)
+              continue;
+            const double bi = i + (up ? 2.0 : 1.0) / 3, bj = j + (up ? 2.0 : 1.0) / 3;
+            const double d = tree.distance(a + (bi / k) * (b - a) + (bj / k) * (c - a));
+            all += area;
+            if (d >= 0.8 * h && d <= 1.2 * h)
+              in += area;
+          }
+    }
+    std::cout << "[ spacing  ] " << gArgs.Mesh << ": " << 100 * in / all << "% of the area within h +- 20% (h = " << h
+              << "), " << r.Sweeps << " sweeps, " << r.Seconds << " s\n";
+    EXPECT_GE(in / all, 0.9) << "h = " << h;
   }
-  std::cout << "[ spacing  ] " << gArgs.Mesh << ": " << 100 * in / all << "% of the area within h +- 20% (h = " << h
-            << "), " << r.Sweeps << " sweeps, " << r.Seconds << " s\n";
-  EXPECT_GE(in / all, 0.9);
 }
 
 int main(int argc, char** argv)
