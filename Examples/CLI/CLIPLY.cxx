@@ -1,8 +1,6 @@
 // SDFCage — CLI: the PLY parser (see CLIParsers.h).
 #include "CLIParsers.h"
 
-#include "Common/LargePages.h" // sdfcage::ReserveLarge (Core)
-
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
@@ -442,13 +440,13 @@ bool parsePLY(const char* data, std::size_t size, ParsedMesh& mesh, std::string&
   }
 
   // --- body -------------------------------------------------------------------------------
-  sdfcage::ReserveLarge(mesh.Points, static_cast<std::size_t>(numberOfVertices) * 3);
+  mesh.Points.reserve(static_cast<std::size_t>(numberOfVertices) * 3);
   for (const Element& e : elements)
   {
     if (e.Name == "face") // the counts fit in the bytes (checked above); triangles are the usual
     {
-      sdfcage::ReserveLarge(mesh.Offsets, static_cast<std::size_t>(e.Count) + 1);
-      sdfcage::ReserveLarge(mesh.Connectivity, static_cast<std::size_t>(e.Count) * 3);
+      mesh.Offsets.reserve(static_cast<std::size_t>(e.Count) + 1);
+      mesh.Connectivity.reserve(static_cast<std::size_t>(e.Count) * 3);
     }
   }
   mesh.Offsets.push_back(0);
