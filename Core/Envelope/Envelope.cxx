@@ -409,6 +409,119 @@ std::size_t projectOntoAmplifiedOffset(
   return moved.load();
 }
 
+/// Adaptive extraction (EnvelopeOptions::Adaptivity) merges the voxels of flat-looking regions
+/// into large polygons whose corners lie on the isosurface; where the offset curves, their flat
+/// interiors cut the corner and come closer to the input than the clearance, or even cross a thin
+/// part. Re-extracting such places without adaptivity costs many uniform triangles (OpenVDB's
+/// adaptivity mask works per leaf of 8^3 voxels), so they are mended here first: the longest edge
+/// of every triangle closer than `margin` to the input is split, and each new midpoint closer than
+/// `c` is moved out along the direction from its closest input point onto the offset {d = c},
+/// where the grid put the corners (flood-fill sign: there the envelope is that offset). Splits
+/// are conforming (splitEdges), so the surface stays closed, manifold and oriented; only triangles
+/// with a new point are measured again. Up to `rounds` rounds, or until no triangle is closer
+/// than `margin`, or `maxTriangles`; verification judges the result as before, and what it still
+/// finds goes to the re-extraction. OpenVDB has no such step; it is a few dozen lines on top of
+/// the mesh refinement the amplified projection uses. Returns the number of points added.
+std::size_t liftCutCorners(
+  TriangleMesh& envelope, const TriangleTree& tree, double c, double margin, int rounds, std::size_t maxTriangles)
+{
+  std::size_t added = 0;
+  std::atomic<std::size_t> skipped{ 0 };
+  std::size_t firstNew = 0; // triangles with a point at or beyond it are measured
+  for (int round = 0; round < rounds && envelope.Triangles.size() < maxTriangles; ++round)
+  {
+    const std::size_t nf = envelope.Triangles.size();
+    std::vector<char> bad(nf, 0);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 512), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t f = r.begin(); f != r.end(); ++f)
+      {
+        const Triangle& t = envelope.Triangles[f];
+        if (round > 0 && std::size_t(std::max({ t[0], t[1], t[2] })) < firstNew)
+          continue;
+        const Vec3 tri[3] = { envelope.Points[t[0]], envelope.Points[t[1]], envelope.Points[t[2]] };
+        bad[f] = tree.anyCloserThan(tri, margin) ? 1 : 0;
+      }
+    });
+    std::vector<std::uint64_t> keys;
+    for (std::size_t f = 0; f < nf; ++f)
+    {
+      if (!bad[f])
+        continue;
+      const Triangle& t = envelope.Triangles[f];
+      int longest = 0;
+      double best = -1.0;
+      for (int k = 0; k < 3; ++k)
+      {
+        const double l = (envelope.Points[t[k]] - envelope.Points[t[(k + 1) % 3]]).squaredNorm();
+        if (l > best)
+        {
+          best = l;
+          longest = k;
+        }
+      }
+      const int a = t[longest], b = t[(longest + 1) % 3];
+      keys.push_back((static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint32_t>(std::max(a, b)));
+    }
+    if (keys.empty())
+      break;
+    std::sort(keys.begin(), keys.end());
+    keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+    // the surface's normal along each edge to split (its two triangles' area-weighted normals)
+    std::vector<Vec3> edgeNormal(keys.size(), Vec3::Zero());
+    for (const Triangle& t : envelope.Triangles)
+      for (int k = 0; k < 3; ++k)
+      {
+        const int a = t[k], b = t[(k + 1) % 3];
+        const std::uint64_t key =
+          (static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint32_t>(std::max(a, b));
+        const auto it = std::lower_bound(keys.begin(), keys.end(), key);
+        if (it != keys.end() && *it == key)
+          edgeNormal[it - keys.begin()] +=
+            (envelope.Points[t[1]] - envelope.Points[t[0]]).cross(envelope.Points[t[2]] - envelope.Points[t[0]]);
+      }
+    const std::size_t before = envelope.Points.size();
+    std::vector<std::array<int, 2>> parents;
+    splitEdges(
+      envelope,
+      [&](int a, int b) {
+        const std::uint64_t key =
+          (static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint32_t>(std::max(a, b));
+        return std::binary_search(keys.begin(), keys.end(), key);
+      },
+      &parents);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(before, envelope.Points.size(), 256),
+      [&](const tbb::blocked_range<std::size_t>& r) {
+        for (std::size_t i = r.begin(); i != r.end(); ++i)
+        {
+          Vec3& x = envelope.Points[i];
+          Vec3 cp;
+          int t = -1;
+          double d = 0.0;
+          if (!tree.closestPoint(x, c, cp, t, d) || !(d < c))
+            continue;
+          const std::array<int, 2>& ab = parents[i - before];
+          const std::uint64_t key = (static_cast<std::uint64_t>(std::min(ab[0], ab[1])) << 32) |
+            static_cast<std::uint32_t>(std::max(ab[0], ab[1]));
+          const Vec3 n = edgeNormal[std::lower_bound(keys.begin(), keys.end(), key) - keys.begin()];
+          const Vec3 dir = x - cp;
+          // out only: a midpoint whose way away from the input is not the surface's outside (it
+          // lies inside a thin part the chord crosses, or the input turns there) stays for now
+          if (!(d > 1e-9 * c) || !(dir.dot(n) > 0.5 * d * n.norm()))
+          {
+            skipped++;
+            continue;
+          }
+          x = cp + dir * (c / d);
+        }
+      });
+    added += envelope.Points.size() - before;
+    firstNew = before;
+  }
+  if (std::getenv("SDFCAGE_DEBUG_ENVELOPE"))
+    std::fprintf(stderr, "lift: %zu points added, %zu not moved\n", added, skipped.load());
+  return added;
+}
+
 } // namespace
 
 const char* signModeName(SignMode m)
@@ -643,6 +756,20 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
       {
         return false; // computeIsosurface reports the cancel
       }
+      if (coarseLevel && result.InputClosed)
+      {
+        // fused on the coarse grid, or too few points for the target (judged before the costly
+        // mending and verification; the accepted envelope is checked again below): the
+        // requested grid decides
+        std::vector<int> comp;
+        if (envelope.Points.size() < options.CoarseMinimumPoints ||
+          (checkTriangleMesh(envelope).usable() &&
+            (triangleComponents(envelope, comp) != result.InputComponents || genus(envelope) != result.InputGenus)))
+        {
+          coarseRejected = true;
+          return true; // stops the extraction
+        }
+      }
       if (options.VertexBudget > 0)
       {
         // too many parts and handles for the target: not worth verifying (a wider one follows)
@@ -663,6 +790,11 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
           result.IsosurfaceSeconds += seconds(t0);
           return true; // stops the extraction; buildEnvelope reports TooComplex
         }
+      }
+      if (adaptivity > 0.0 && options.LiftCutCorners && !(amplification && !amplification->empty()))
+      {
+        result.LiftedPoints +=
+          liftCutCorners(envelope, tree(), c, 1.2 * delta, 6, 4 * envelope.Triangles.size() + 1024);
       }
       if (amplification && !amplification->empty())
       {

@@ -112,6 +112,11 @@ CageResult generateOnce(const PreparedInput& prepared, const CageOptions& option
   EnvelopeOptions envelopeOptions = options.Envelope;
   envelopeOptions.ExactEnvelopeClearance =
     envelopeOptions.ExactEnvelopeClearance || options.TargetNumberOfVertices <= 0;
+  // the coarse grid first only for a cage simplified from it, with room for the target (the
+  // dense envelope as the cage comes from the grid asked for)
+  envelopeOptions.CoarseFirst = envelopeOptions.CoarseFirst && options.TargetNumberOfVertices > 0;
+  envelopeOptions.CoarseMinimumPoints = std::max<std::size_t>(
+    envelopeOptions.CoarseMinimumPoints, 4 * static_cast<std::size_t>(std::max(0, options.TargetNumberOfVertices)));
   if (mayWiden && !result.Defects.usable() && options.TargetNumberOfVertices > 0)
   {
     envelopeOptions.VertexBudget = options.TargetNumberOfVertices; // too complex: not even verified
@@ -473,12 +478,13 @@ CageResult generateCage(const PolygonMesh& input, const CageOptions& options, Pr
   // A cage simplified from the coarse grid's envelope (EnvelopeOptions::CoarseFirst) that misses
   // its target (small targets: the coarse envelope's merged polygons leave the simplifier fewer
   // placements) is made again from the requested grid's envelope; the one with fewer vertices
-  // is kept.
+  // is kept. (The grid requested is that of the isovalue built, which the probes may have
+  // widened: its c/2 grid is no coarse grid.)
   if (best.State == Status::Ok && !best.TargetReached && options.TargetNumberOfVertices > 0 &&
-    options.Envelope.CoarseFirst && best.VoxelSizeUsed > options.Envelope.voxelSize() * (1.0 + 1e-9) &&
+    options.Envelope.CoarseFirst && best.VoxelSizeUsed > first.Envelope.voxelSize() * (1.0 + 1e-9) &&
     !progressCancelled(progress))
   {
-    CageOptions requested = options;
+    CageOptions requested = first;
     requested.Envelope.CoarseFirst = false;
     progressStage(progress, "the envelope on the requested grid, to reach the target", 0.0, 1.0);
     CageResult next = generateOnce(prepared, requested, progress, options.MaximumEnvelopeWidenings > 0);

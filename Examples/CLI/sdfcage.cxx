@@ -125,7 +125,7 @@ void printUsage(std::ostream& os)
         "      --coarse-first      with the automatic voxel size, try the grid twice as coarse\n"
         "                          first: a closed input without active points is tried on it and\n"
         "                          kept only if verified with the input's genus and parts, else\n"
-        "                          the C/2 grid follows (default off; --no-coarse-first: off)\n"
+        "                          the C/2 grid follows (default on; --no-coarse-first: off)\n"
         "      --memory-limit MB   memory budget of the envelope (distance grid, isosurface,\n"
         "                          verification), estimated before each grid is built: over it the\n"
         "                          run stops with the need named (exit 3); default 0 = automatic\n"

@@ -301,6 +301,42 @@ TEST(CoarseFirst, KeepsWhatTheRequestedGridKeeps)
   EXPECT_GE(fellBack, 1) << "no torus exercised the fallback from the coarse grid";
 }
 
+// The adaptive envelope's cut corners mended (EnvelopeOptions::LiftCutCorners): on a grid as
+// coarse as the isovalue with a high adaptivity, the merged polygons around the rounded edges of
+// an offset box and around a thin ring cut into the clearance. Mended, the envelope passes verification
+// (judged again here by the exact referee) with fewer triangles than the re-extraction without
+// adaptivity around the defects gives without the mending.
+TEST(LiftCutCorners, MendsTheAdaptiveEnvelopeWithFewerTriangles)
+{
+  const TriangleMesh box = makeBox(Vec3(-0.6, -0.5, -0.4), Vec3(0.6, 0.5, 0.4));
+  const TriangleMesh torus = makeTorus(Vec3(0.0, 0.0, 0.0), 0.9, 0.05, 192, 24); // a thin ring
+  for (const auto& shape : { std::make_pair(std::string("box"), box), std::make_pair(std::string("torus"), torus) })
+  {
+    EnvelopeOptions lifted;
+    lifted.VoxelSize = lifted.IsoValue; // the coarse grid
+    lifted.Adaptivity = 0.9;
+    lifted.UseActivePoints = false;
+    lifted.MaximumRefinements = 0;
+    EnvelopeOptions plain = lifted;
+    plain.LiftCutCorners = false;
+    const EnvelopeResult a = buildEnvelope(shape.second, lifted);
+    const EnvelopeResult b = buildEnvelope(shape.second, plain);
+    std::cout << "[ lift     ] " << shape.first << ": mended " << a.Envelope.Triangles.size() << " triangles ("
+              << a.LiftedPoints << " points added, " << a.AdaptiveRepairs << " re-extractions), not mended "
+              << b.Envelope.Triangles.size() << " triangles (" << b.AdaptiveRepairs << " re-extractions, "
+              << statusName(b.State) << ")\n";
+    ASSERT_EQ(a.State, Status::Ok) << shape.first << ": " << a.Message;
+    EXPECT_GT(a.LiftedPoints, 0u) << shape.first << ": nothing to mend, the test does not test it";
+    EXPECT_EQ(b.LiftedPoints, 0u);
+    EXPECT_GT(b.AdaptiveRepairs, 0) << shape.first << ": the adaptive envelope passed unmended";
+    if (b.State == Status::Ok)
+      EXPECT_LT(a.Envelope.Triangles.size(), b.Envelope.Triangles.size()) << shape.first;
+    EXPECT_EQ(a.Genus, shape.first == "torus" ? 1 : 0);
+    EXPECT_EQ(a.Components, 1);
+    expectEncloses(shape.second, a.Envelope, lifted.clearance(), 2.0 * lifted.IsoValue, shape.first + ", mended");
+  }
+}
+
 // A closed tube along a circle that runs on past its start and through its own first part (the
 // cow's tail pushed into its body): the surface has genus 0, the solid the flood fill sees is a
 // ring (genus 1). No envelope can separate what the input itself joins, so no topology repair
