@@ -766,6 +766,10 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
           (checkTriangleMesh(envelope).usable() &&
             (triangleComponents(envelope, comp) != result.InputComponents || genus(envelope) != result.InputGenus)))
         {
+          if (std::getenv("SDFCAGE_DEBUG_ENVELOPE"))
+            std::fprintf(stderr, "coarse grid rejected: %zu points, %d parts, genus %d (input %d, %d)\n",
+              envelope.Points.size(), triangleComponents(envelope, comp), genus(envelope), result.InputComponents,
+              result.InputGenus);
           coarseRejected = true;
           return true; // stops the extraction
         }
