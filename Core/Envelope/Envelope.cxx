@@ -6,6 +6,7 @@
 #include "Quality/Verification.h"
 #include "Spatial/TriangleIndex.h"
 #include "Spatial/TriangleTree.h"
+#include "Mesh/EdgeKey.h"
 #include "Mesh/Validation.h"
 
 #include <tbb/blocked_range.h>
@@ -459,8 +460,7 @@ std::size_t liftCutCorners(
           longest = k;
         }
       }
-      const int a = t[longest], b = t[(longest + 1) % 3];
-      keys.push_back((static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint32_t>(std::max(a, b)));
+      keys.push_back(edgeKey(t[longest], t[(longest + 1) % 3]));
     }
     if (keys.empty())
       break;
@@ -471,9 +471,7 @@ std::size_t liftCutCorners(
     for (const Triangle& t : envelope.Triangles)
       for (int k = 0; k < 3; ++k)
       {
-        const int a = t[k], b = t[(k + 1) % 3];
-        const std::uint64_t key =
-          (static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint32_t>(std::max(a, b));
+        const std::uint64_t key = edgeKey(t[k], t[(k + 1) % 3]);
         const auto it = std::lower_bound(keys.begin(), keys.end(), key);
         if (it != keys.end() && *it == key)
           edgeNormal[it - keys.begin()] +=
@@ -482,13 +480,7 @@ std::size_t liftCutCorners(
     const std::size_t before = envelope.Points.size();
     std::vector<std::array<int, 2>> parents;
     splitEdges(
-      envelope,
-      [&](int a, int b) {
-        const std::uint64_t key =
-          (static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint32_t>(std::max(a, b));
-        return std::binary_search(keys.begin(), keys.end(), key);
-      },
-      &parents);
+      envelope, [&](int a, int b) { return std::binary_search(keys.begin(), keys.end(), edgeKey(a, b)); }, &parents);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(before, envelope.Points.size(), 256),
       [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i)
@@ -500,9 +492,7 @@ std::size_t liftCutCorners(
           if (!tree.closestPoint(x, c, cp, t, d) || !(d < c))
             continue;
           const std::array<int, 2>& ab = parents[i - before];
-          const std::uint64_t key = (static_cast<std::uint64_t>(std::min(ab[0], ab[1])) << 32) |
-            static_cast<std::uint32_t>(std::max(ab[0], ab[1]));
-          const Vec3 n = edgeNormal[std::lower_bound(keys.begin(), keys.end(), key) - keys.begin()];
+          const Vec3 n = edgeNormal[std::lower_bound(keys.begin(), keys.end(), edgeKey(ab[0], ab[1])) - keys.begin()];
           const Vec3 dir = x - cp;
           // out only: a midpoint whose way away from the input is not the surface's outside (it
           // lies inside a thin part the chord crosses, or the input turns there) stays for now

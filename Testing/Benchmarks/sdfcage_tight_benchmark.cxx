@@ -19,6 +19,7 @@
 #include "Optimization/Optimization.h"
 #include "Pipeline/CageGenerator.h"
 #include "Quality/CageQuality.h"
+#include "SpacingBand.h"
 #include "Spatial/TriangleTree.h"
 
 #include <tbb/global_control.h>
@@ -64,38 +65,6 @@ double smallAngles(const TriangleMesh& m, double angle)
       n += std::atan2(u.cross(w).norm(), u.dot(w)) * 180.0 / M_PI < angle;
     }
   return m.Triangles.empty() ? 0.0 : double(n) / double(3 * m.Triangles.size());
-}
-
-/// Fraction of the cage's area (unit-sphere units) whose distance to the input lies within
-/// [lo, hi]: each triangle split into 4^4 = 256 sub-triangles, judged at their centroids.
-double bandFraction(const TriangleMesh& cage, const TriangleTree& tree, double lo, double hi)
-{
-  const int n = 16;
-  double in = 0.0, all = 0.0;
-  for (const Triangle& t : cage.Triangles)
-  {
-    const Vec3& a = cage.Points[t[0]];
-    const Vec3& b = cage.Points[t[1]];
-    const Vec3& c = cage.Points[t[2]];
-    const double area = 0.5 * (b - a).cross(c - a).norm() / (n * n);
-    // the n^2 sub-triangles of the uniform grid: upright (i, j) and inverted ones
-    for (int i = 0; i < n; ++i)
-      for (int j = 0; i + j < n; ++j)
-      {
-        for (int up = 0; up < 2; ++up)
-        {
-          if (up == 1 && i + j + 1 >= n)
-            continue;
-          const double bi = up == 0 ? i + 1.0 / 3 : i + 2.0 / 3, bj = up == 0 ? j + 1.0 / 3 : j + 2.0 / 3;
-          const Vec3 x = a + (bi / n) * (b - a) + (bj / n) * (c - a);
-          const double d = tree.distance(x);
-          all += area;
-          if (d >= lo && d <= hi)
-            in += area;
-        }
-      }
-  }
-  return all > 0 ? in / all : 0.0;
 }
 
 } // namespace

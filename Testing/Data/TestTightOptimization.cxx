@@ -17,6 +17,7 @@
 #include "Optimization/Optimization.h"
 #include "Pipeline/CageGenerator.h"
 #include "Quality/CageQuality.h"
+#include "SpacingBand.h"
 #include "Spatial/TriangleTree.h"
 
 #include <gtest/gtest.h>
@@ -112,33 +113,11 @@ TEST(Tight, Spacing)
     o.Clearance = CageOptions().Envelope.clearance();
     const OptimizeResult r = optimizeCageInInputUnits(p.Cage.Cage, p.Input, o);
     expectGuarantees(p, r, "spacing");
-    // the area fraction within h +- 20% (unit-sphere units): each triangle split into 256, judged
-    // at the sub-triangles' centroids
-    const TriangleMesh unit = n.toUnit(r.Cage);
-    const int k = 16;
-    double in = 0.0, all = 0.0;
-    for (const Triangle& t : unit.Triangles)
-    {
-      const Vec3& a = unit.Points[t[0]];
-      const Vec3& b = unit.Points[t[1]];
-      const Vec3& c = unit.Points[t[2]];
-      const double area = 0.5 * (b - a).cross(c - a).norm() / (k * k);
-      for (int i = 0; i < k; ++i)
-        for (int j = 0; i + j < k; ++j)
-          for (int up = 0; up < 2; ++up)
-          {
-            if (up == 1 && i + j + 1 >= k)
-              continue;
-            const double bi = i + (up ? 2.0 : 1.0) / 3, bj = j + (up ? 2.0 : 1.0) / 3;
-            const double d = tree.distance(a + (bi / k) * (b - a) + (bj / k) * (c - a));
-            all += area;
-            if (d >= 0.8 * h && d <= 1.2 * h)
-              in += area;
-          }
-    }
-    std::cout << "[ spacing  ] " << gArgs.Mesh << ": " << 100 * in / all << "% of the area within h +- 20% (h = " << h
+    // the area fraction within h +- 20% (unit-sphere units)
+    const double fraction = bandFraction(n.toUnit(r.Cage), tree, 0.8 * h, 1.2 * h);
+    std::cout << "[ spacing  ] " << gArgs.Mesh << ": " << 100 * fraction << "% of the area within h +- 20% (h = " << h
               << "), " << r.Sweeps << " sweeps, " << r.Seconds << " s\n";
-    EXPECT_GE(in / all, 0.9) << "h = " << h;
+    EXPECT_GE(fraction, 0.9) << "h = " << h;
   }
 }
 
