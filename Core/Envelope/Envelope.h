@@ -77,7 +77,9 @@ struct EnvelopeOptions
   /// 500-vertex cage of the torus of core.Optimization.MIPSReachesFifteenDegreesAndStaysTight
   /// had a needle MIPS could not lift to 15 degrees (it passes now). Measured on the shared
   /// closed meshes at 500 vertices: 1.4-3x faster wherever the coarse envelope keeps the
-  /// topology (README, "Time that follows the work"); otherwise the requested grid follows.
+  /// topology (README, "Time that follows the work"). Where it fuses parts (or holds too few
+  /// points), a grid between follows (voxel 4/3 of the requested one, judged the same way), and
+  /// then the requested grid as if no coarse one had been tried.
   bool CoarseFirst = true;
   /// The coarse grid's envelope is kept only with at least this many points (generateCage asks
   /// 4x its target: a coarse envelope of a small shape or a large isovalue could otherwise hold

@@ -276,9 +276,11 @@ TEST(CoarseFirst, KeepsWhatTheRequestedGridKeeps)
   EXPECT_DOUBLE_EQ(sf.VoxelSizeUsed, fine.voxelSize());
   EXPECT_LT(s.Envelope.Triangles.size(), sf.Envelope.Triangles.size());
 
-  int fellBack = 0;
+  // hole 0.026: the coarse grids fuse the handle, the requested grid keeps it; 0.03: the grid
+  // between (voxel 4/3 of the requested one) keeps it; 0.04: the coarsest keeps it
+  int fellBack = 0, between = 0;
   coarse.UseActivePoints = fine.UseActivePoints = false;
-  for (double hole : { 0.026, 0.04 })
+  for (double hole : { 0.026, 0.03, 0.04 })
   {
     // in the unit sphere: R + r = 1, hole diameter 2 (R - r)
     const double R = 0.5 * (1.0 + 0.5 * hole), r = 0.5 * (1.0 - 0.5 * hole);
@@ -296,9 +298,15 @@ TEST(CoarseFirst, KeepsWhatTheRequestedGridKeeps)
       EXPECT_EQ(a.Genus, 1) << name << ": the coarse grid lost the handle the requested grid keeps";
     }
     fellBack += a.VoxelSizeUsed < coarse.IsoValue ? 1 : 0;
+    between += std::abs(a.VoxelSizeUsed - fine.voxelSize() * 4.0 / 3.0) < 1e-12 ? 1 : 0;
+    if (a.VoxelSizeUsed < coarse.IsoValue)
+    {
+      EXPECT_LT(a.Envelope.Triangles.size(), 1.2 * b.Envelope.Triangles.size()) << name;
+    }
     expectEncloses(torus, a.Envelope, coarse.clearance(), 2.0 * coarse.IsoValue, name + ", coarse first");
   }
-  EXPECT_GE(fellBack, 1) << "no torus exercised the fallback from the coarse grid";
+  EXPECT_GE(fellBack, 2) << "no torus exercised the fallback from the coarse grid";
+  EXPECT_GE(between, 1) << "no torus kept its handle on the grid between the coarse and the requested one";
 }
 
 // The adaptive envelope's cut corners mended (EnvelopeOptions::LiftCutCorners): on a grid as
