@@ -287,8 +287,8 @@ public:
   /**
    * Coarse grid first: with the automatic voxel size, a closed input without active points is
    * first sampled on a grid twice as coarse (voxel = IsoValue); its envelope is kept only when it
-   * is verified and has the input's genus and parts, otherwise the automatic grid (IsoValue / 2)
-   * follows. VoxelSizeUsed in the field data says which grid was kept. Default on (Core's).
+   * is verified and has the input's genus and parts, otherwise a grid between (voxel 2/3 of the
+   * IsoValue, judged the same way) and then the automatic grid (IsoValue / 2) follow. VoxelSizeUsed in the field data says which grid was kept. Default on (Core's).
    */
   vtkSetMacro(CoarseFirst, vtkTypeBool);
   vtkGetMacro(CoarseFirst, vtkTypeBool);
