@@ -72,41 +72,6 @@ int componentsOf(const TriangleMesh& mesh)
   return triangleComponents(mesh, component);
 }
 
-/// The smallest distance between two parts of `mesh` when it is below `limit` (exact triangle
-/// distances), else `limit` (also for a mesh of one part).
-double gapBetweenParts(const TriangleMesh& mesh, double limit)
-{
-  std::vector<int> component;
-  const int parts = triangleComponents(mesh, component);
-  double gap = limit;
-  for (int c = 0; c + 1 < parts; ++c)
-  {
-    // the triangles of part c against those of the later parts
-    TriangleMesh others;
-    others.Points = mesh.Points;
-    for (std::size_t f = 0; f < mesh.Triangles.size(); ++f)
-      if (component[f] > c)
-        others.Triangles.push_back(mesh.Triangles[f]);
-    const TriangleTree tree(others);
-    std::vector<int> near;
-    for (std::size_t f = 0; f < mesh.Triangles.size(); ++f)
-    {
-      if (component[f] != c)
-        continue;
-      const Triangle& t = mesh.Triangles[f];
-      const Vec3 a[3] = { mesh.Points[t[0]], mesh.Points[t[1]], mesh.Points[t[2]] };
-      near.clear();
-      tree.trianglesWithin(a, gap, near);
-      for (int g : near)
-      {
-        const Triangle& u = others.Triangles[g];
-        const Vec3 b[3] = { mesh.Points[u[0]], mesh.Points[u[1]], mesh.Points[u[2]] };
-        gap = std::min(gap, std::sqrt(triangleTriangleDistance2(a, b)));
-      }
-    }
-  }
-  return gap;
-}
 } // namespace
 
 std::string sortNestedCounts(std::vector<int>& counts)
@@ -194,6 +159,15 @@ NestedCageResult generateNestedCages(
     levelOptions.Envelope.CoarseFirst = false;
     levelOptions.Envelope.LiftCutCorners = false;
     levelOptions.TargetNumberOfVertices = counts[k];
+    // Room between this level's parts for the next one (SimplifyOptions::PartClearance, as far as
+    // this level's envelope leaves room): the next envelope lies the isovalue c out from each
+    // part (closer only at active points), so parts less than 2c apart fuse in it. 2.2 c, 10%
+    // for the next level's normalization and the extraction. Without it the simplifier lets
+    // parts come as close as the self clearance (c / 16). Measured with two spheres 0.08 apart,
+    // levels 400, 100, 40: the 100-vertex level's parts 0.0135 apart without, 0.036 with; the
+    // 40-vertex level fused (96 vertices, one part) without, two parts and 40 vertices with.
+    if (k + 1 < L)
+      levelOptions.Simplify.PartClearance = 2.2 * levelOptions.Envelope.IsoValue;
     NestedLevel level;
     level.TargetNumberOfVertices = counts[k];
     if (k == 0)
@@ -273,7 +247,7 @@ NestedCageResult generateNestedCages(
       // self clearance cannot stay apart, whatever the vertex count.
       const double clearance = r.Normalize.lengthToInput(r.ClearanceUsedRelative);
       const double needed = 2.0 * clearance + clearance / 4;
-      const double gap = gapBetweenParts(nested.Levels[k - 1].Result.Cage, needed);
+      const double gap = distanceBetweenParts(nested.Levels[k - 1].Result.Cage, needed);
       if (gap < needed)
       {
         std::ostringstream why;

@@ -165,6 +165,8 @@ ResultTable cageResults(const CageResult& r)
     integer("CollapsesRejectedByTopology", s.RejectedTopology, "count", "... by the link condition"),
     integer("CollapsesRejectedByShape", s.RejectedShape, "count", "... by a flip or a needle"),
     integer("RelocatedPlacements", s.Relocated, "count", "infeasible placements replaced by a feasible one"),
+    real("PartClearanceUsed", s.PartClearanceUsed, "relative",
+      "room kept between the cage's parts for the next nested level (0: none asked or one part)"),
     // the optional optimization (paper 3.3)
     flag("Optimized", r.Optimized, "the optimization ran and its result is the cage"),
   };

@@ -162,6 +162,8 @@ bool LocalChangeVeto::inputClear(const std::vector<ChangedTriangle>& tris, const
 bool LocalChangeVeto::selfIntersectionFree(LocalChangeScratch& s, LocalChangeFindings* findings) const
 {
   const double selfDelta = Policy.SelfClearance;
+  const bool parts = Policy.PartClearance > selfDelta && Cage.Part && !Cage.Part->empty();
+  const double reach = parts ? Policy.PartClearance : selfDelta;
   const std::vector<Vec3>& P = *Cage.Points;
   const std::vector<Triangle>& T = *Cage.Triangles;
   // one grid query for the whole new one-ring, then per pair a box test, the early-outs and the
@@ -173,8 +175,8 @@ bool LocalChangeVeto::selfIntersectionFree(LocalChangeScratch& s, LocalChangeFin
       ringLo = ringLo.cwiseMin(q);
       ringHi = ringHi.cwiseMax(q);
     }
-  ringLo -= Vec3::Constant(selfDelta);
-  ringHi += Vec3::Constant(selfDelta);
+  ringLo -= Vec3::Constant(reach);
+  ringHi += Vec3::Constant(reach);
   if (findings)
   {
     findings->Read = true;
@@ -211,12 +213,15 @@ bool LocalChangeVeto::selfIntersectionFree(LocalChangeScratch& s, LocalChangeFin
   });
   for (const ChangedTriangle& nt : s.Tris)
   {
-    const Vec3 lo = nt.Pts[0].cwiseMin(nt.Pts[1]).cwiseMin(nt.Pts[2]) - Vec3::Constant(selfDelta);
-    const Vec3 hi = nt.Pts[0].cwiseMax(nt.Pts[1]).cwiseMax(nt.Pts[2]) + Vec3::Constant(selfDelta);
+    const Vec3 lo = nt.Pts[0].cwiseMin(nt.Pts[1]).cwiseMin(nt.Pts[2]) - Vec3::Constant(reach);
+    const Vec3 hi = nt.Pts[0].cwiseMax(nt.Pts[1]).cwiseMax(nt.Pts[2]) + Vec3::Constant(reach);
+    const int ntPart = parts ? (*Cage.Part)[nt.Ids[0]] : 0;
     for (auto& c : candidates)
     {
       if ((c.Lo.array() > hi.array()).any() || (c.Hi.array() < lo.array()).any())
         continue;
+      // another part keeps PartClearance (it shares no vertex with this one)
+      const double delta = parts && (*Cage.Part)[c.Ids[0]] != ntPart ? Policy.PartClearance : selfDelta;
       int shared = 0, ka = -1, kb = -1;
       for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j)
@@ -240,13 +245,13 @@ bool LocalChangeVeto::selfIntersectionFree(LocalChangeScratch& s, LocalChangeFin
         c.C = (c.Pts[0] + c.Pts[1] + c.Pts[2]) / 3.0;
         c.R = std::max({ (c.Pts[0] - c.C).norm(), (c.Pts[1] - c.C).norm(), (c.Pts[2] - c.C).norm() });
       }
-      // disjoint triangles whose bounding spheres are farther apart than selfDelta cannot conflict
-      if (disjoint && (c.C - nt.C).norm() - c.R - nt.R >= selfDelta)
+      // disjoint triangles whose bounding spheres are farther apart than delta cannot conflict
+      if (disjoint && (c.C - nt.C).norm() - c.R - nt.R >= delta)
         continue;
-      // nor those a separating axis keeps selfDelta apart
-      if (disjoint && separatedByAxesImpl(nt, c, selfDelta))
+      // nor those a separating axis keeps delta apart
+      if (disjoint && separatedByAxesImpl(nt, c, delta))
         continue;
-      if (!trianglesConflict(nt.Ids, nt.Pts, c.Ids, c.Pts, selfDelta, Policy.FoldCosine))
+      if (!trianglesConflict(nt.Ids, nt.Pts, c.Ids, c.Pts, delta, Policy.FoldCosine))
         continue;
       if (!Policy.RelaxCloserPairs || !disjoint)
         return false;

@@ -92,6 +92,12 @@ struct LocalChangePolicy
   bool CheckSelfIntersection = true;
   /// SelfIntersection: distance kept between cage triangles that share no vertex.
   double SelfClearance = 0.0025 / 4;
+  /// SelfIntersection: distance kept between triangles of different parts (CageView::Part), when
+  /// larger than SelfClearance: room between parts (the nested cages' next level must pass
+  /// between them).
+  double PartClearance = 0.0;
+  /// The widest distance the SelfIntersection test keeps (its neighbourhood reaches that far).
+  double selfReach() const { return PartClearance > SelfClearance ? PartClearance : SelfClearance; }
   /// SelfIntersection: a pair that shares no vertex and was already closer than SelfClearance
   /// before the change (ChangedTriangle::Before) may stay closer: it must keep half its distance
   /// before, and not touch (the optimizer: a given cage may have such pairs).
@@ -187,6 +193,9 @@ struct CageView
   const std::vector<Vec3>* BoxLo = nullptr;
   const std::vector<Vec3>* BoxHi = nullptr;
   const CageGrid* Grid = nullptr;
+  /// Per point: its part (connected component), for LocalChangePolicy::PartClearance; null or
+  /// empty: no part rule.
+  const std::vector<int>* Part = nullptr;
 };
 
 /// The veto. Const and thread-safe: everything a check writes is in the scratch (one per thread)

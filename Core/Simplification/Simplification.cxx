@@ -143,10 +143,30 @@ public:
     , Opt(o)
     , Original(o)
     , Prog(p)
-    , Veto(policy(o), input, CageView{ &P, &T, &TAlive, nullptr, nullptr, &Grid })
+    , Veto(policy(o), input, CageView{ &P, &T, &TAlive, nullptr, nullptr, &Grid, &Part })
   {
     P = mesh.Points;
     T = mesh.Triangles;
+    if (o.PartClearance > o.selfClearance())
+    {
+      // room between parts: as asked, but no more than the envelope's parts have
+      std::vector<int> component;
+      if (triangleComponents(mesh, component) > 1)
+      {
+        const double room = std::min(o.PartClearance, 0.95 * distanceBetweenParts(mesh, o.PartClearance / 0.95));
+        if (room > o.selfClearance())
+        {
+          Part.assign(P.size(), 0);
+          for (std::size_t f = 0; f < T.size(); ++f)
+            for (int v : T[f])
+              Part[v] = component[f];
+          LocalChangePolicy p = Veto.policy();
+          p.PartClearance = room;
+          Veto.setPolicy(p);
+          PartRoom = room;
+        }
+      }
+    }
     VAlive.assign(P.size(), 1);
     TAlive.assign(T.size(), 1);
     VT.assign(P.size(), {});
@@ -241,6 +261,7 @@ public:
     r.GaveUp = GaveUp;
     r.VerticesReached = AliveVertices;
     r.TargetReached = AliveVertices <= target;
+    r.PartClearanceUsed = PartRoom;
     if (!r.TargetReached)
       r.StopReason = r.Cancelled ? "cancelled"
         : GaveUp ? "the ordinary pass ended above " + std::to_string(Opt.GiveUpAbove) +
@@ -262,7 +283,7 @@ public:
     std::vector<Eval> batch(BatchSize);
     std::vector<Entry> aside;
     std::vector<std::pair<Vec3, Vec3>> formBoxes, writeBoxes;
-    const double margin = Opt.selfClearance();
+    const double margin = std::max(Opt.selfClearance(), PartRoom);
     while (AliveVertices > target && !Heap.empty())
     {
       // progress every 16 batches; a cancel check every batch (a batch is some 10 ms, 16 of them
@@ -445,7 +466,9 @@ public:
   {
     Opt.MinimumNormalCosine = std::min(Opt.MinimumNormalCosine, 0.0);
     Opt.MinimumTriangleQuality = 0.5 * Original.MinimumTriangleQuality;
-    Veto.setPolicy(policy(Opt));
+    LocalChangePolicy p = policy(Opt);
+    p.PartClearance = PartRoom;
+    Veto.setPolicy(p);
   }
 
   // The placement `pos` of the gathered collapse failed with verdict `first`. Looks for a
@@ -1021,7 +1044,9 @@ private:
   bool GaveUp = false; ///< stopped after pass 0 (SimplifyOptions::GiveUpAbove)
   double PlacementReach = std::numeric_limits<double>::infinity();
   static constexpr int MaxRetries = 16;
-  LocalChangeVeto Veto; // reads P, T, TAlive and Grid
+  std::vector<int> Part; // per vertex: its part, when room is kept between parts (else empty)
+  double PartRoom = 0.0; // SimplifyOptions::PartClearance as used (0: off)
+  LocalChangeVeto Veto;  // reads P, T, TAlive, Grid and Part
 };
 
 } // namespace

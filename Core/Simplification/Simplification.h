@@ -24,6 +24,13 @@ struct SimplifyOptions
   /// no vertex with it; triangles sharing a vertex or an edge must not intersect or fold.
   /// 0 = Clearance / 4 (the dense envelope's own 2-ring neighbours are closer than Clearance).
   double SelfClearance = 0.0;
+  /// When larger than the self clearance: every new cage triangle keeps at least this distance
+  /// from the triangles of the cage's other parts (connected components), up to 0.95 of the
+  /// distance the envelope's parts have to begin with (a cage cannot keep more room than the
+  /// envelope gives). Room between parts for what is built on the cage: a nested cage's next
+  /// level must enclose each part with its clearance and keep them apart (NestedCages.cxx).
+  /// 0 = off.
+  double PartClearance = 0.0;
   /// Needle bound: a new triangle's quality 4*sqrt(3)*area / (sum of squared edges), 1 for
   /// equilateral, must be at least this (0.02 is a minimum angle of roughly 0.7 degrees).
   double MinimumTriangleQuality = 0.02;
@@ -58,6 +65,9 @@ struct SimplifyResult
   TriangleMesh Cage; ///< unit-sphere units
   int VerticesReached = 0;
   bool TargetReached = false;
+  /// The room kept between parts (SimplifyOptions::PartClearance as capped by the envelope's
+  /// parts; 0 when not asked or the envelope has one part).
+  double PartClearanceUsed = 0.0;
   bool Cancelled = false;
   bool GaveUp = false; ///< stopped after the ordinary pass (SimplifyOptions::GiveUpAbove)
   std::string StopReason; ///< why it stopped before the target (empty when reached)

@@ -509,6 +509,40 @@ bool TriangleTree::closestPoint(const Vec3& p, double maxDistance, Vec3& closest
   return true;
 }
 
+double distanceBetweenParts(const TriangleMesh& mesh, double limit)
+{
+  std::vector<int> component;
+  const int parts = triangleComponents(mesh, component);
+  double gap = limit;
+  for (int c = 0; c + 1 < parts; ++c)
+  {
+    // the triangles of part c against those of the later parts
+    TriangleMesh others;
+    others.Points = mesh.Points;
+    for (std::size_t f = 0; f < mesh.Triangles.size(); ++f)
+      if (component[f] > c)
+        others.Triangles.push_back(mesh.Triangles[f]);
+    const TriangleTree tree(others);
+    std::vector<int> near;
+    for (std::size_t f = 0; f < mesh.Triangles.size(); ++f)
+    {
+      if (component[f] != c)
+        continue;
+      const Triangle& t = mesh.Triangles[f];
+      const Vec3 a[3] = { mesh.Points[t[0]], mesh.Points[t[1]], mesh.Points[t[2]] };
+      near.clear();
+      tree.trianglesWithin(a, gap, near);
+      for (int g : near)
+      {
+        const Triangle& u = others.Triangles[g];
+        const Vec3 b[3] = { mesh.Points[u[0]], mesh.Points[u[1]], mesh.Points[u[2]] };
+        gap = std::min(gap, std::sqrt(triangleTriangleDistance2(a, b)));
+      }
+    }
+  }
+  return gap;
+}
+
 double TriangleTree::distance(const Vec3& p) const
 {
   Vec3 q;

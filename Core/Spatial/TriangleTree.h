@@ -12,6 +12,10 @@ namespace sdfcage
 
 class Progress;
 
+/// The smallest distance between two parts of `mesh` when it is below `limit` (exact triangle
+/// distances), else `limit` (also for a mesh of one part).
+double distanceBetweenParts(const TriangleMesh& mesh, double limit);
+
 class TriangleTree
 {
 public:
