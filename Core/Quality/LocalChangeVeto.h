@@ -96,8 +96,6 @@ struct LocalChangePolicy
   /// larger than SelfClearance: room between parts (the nested cages' next level must pass
   /// between them).
   double PartClearance = 0.0;
-  /// The widest distance the SelfIntersection test keeps (its neighbourhood reaches that far).
-  double selfReach() const { return PartClearance > SelfClearance ? PartClearance : SelfClearance; }
   /// SelfIntersection: a pair that shares no vertex and was already closer than SelfClearance
   /// before the change (ChangedTriangle::Before) may stay closer: it must keep half its distance
   /// before, and not touch (the optimizer: a given cage may have such pairs).
