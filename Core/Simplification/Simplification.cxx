@@ -149,9 +149,11 @@ public:
     T = mesh.Triangles;
     if (o.PartClearance > o.selfClearance())
     {
-      // room between parts: as asked, but no more than the envelope's parts have
+      // room between parts: as asked, but no more than the envelope's parts have (measured part
+      // against the later parts, a tree each: up to 16 parts)
       std::vector<int> component;
-      if (triangleComponents(mesh, component) > 1)
+      const int parts = triangleComponents(mesh, component);
+      if (parts > 1 && parts <= 16)
       {
         const double room = std::min(o.PartClearance, 0.95 * distanceBetweenParts(mesh, o.PartClearance / 0.95));
         if (room > o.selfClearance())

@@ -29,6 +29,7 @@ struct SimplifyOptions
   /// distance the envelope's parts have to begin with (a cage cannot keep more room than the
   /// envelope gives). Room between parts for what is built on the cage: a nested cage's next
   /// level must enclose each part with its clearance and keep them apart (NestedCages.cxx).
+  /// Envelopes of more than 16 parts keep none (measuring the room costs a tree per part).
   /// 0 = off.
   double PartClearance = 0.0;
   /// Needle bound: a new triangle's quality 4*sqrt(3)*area / (sum of squared edges), 1 for
