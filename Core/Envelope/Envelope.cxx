@@ -843,11 +843,14 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
       result.VerificationSeconds += seconds(t1);
       return ok;
     };
-    IsosurfaceOutput iso = computeIsosurface(unitInput, h, c, options.KeepDistanceField, progress, adaptivities,
-      amplification, &judge, 4, result.SignUsed, flood ? nullptr : &tree());
+    IsosurfaceOutput iso =
+      computeIsosurface(unitInput, h, c, options.KeepDistanceField, progress, adaptivities, amplification, &judge, 4,
+        result.SignUsed, flood ? nullptr : &tree(), options.ClusteredField && !std::getenv("SDFCAGE_EXACT_FIELD"));
     result.WindingSeconds += iso.WindingSeconds;
     result.WindingEvaluations += iso.WindingEvaluations;
     result.AmplifiedVoxels = iso.AmplifiedVoxels;
+    if (accepted)
+      result.FieldTriangles = iso.FieldTriangles;
     result.AmplificationSeconds += iso.AmplificationSeconds;
     result.AdaptiveRepairs = iso.Repairs;
     result.DistanceFieldSeconds += iso.DistanceFieldSeconds;

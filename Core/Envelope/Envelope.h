@@ -101,6 +101,11 @@ struct EnvelopeOptions
   ActivePointOptions ActivePoints;
   /// Keep the sampled SDF as a dense image (for display).
   bool KeepDistanceField = false;
+  /// Where the input's triangles are much smaller than the voxels, compute the distance field
+  /// from a vertex-clustered proxy (cells of one voxel; points near active samples kept) when
+  /// that drops at least a tenth of the triangles. The envelope is verified against the input
+  /// itself either way. Off with KeepDistanceField (the displayed field stays exact).
+  bool ClusteredField = true;
   /// When > 0: an extracted envelope whose parts and handles need more cage vertices than this
   /// (minimumCageVertices) is not verified; the result says TooComplex (the pipeline then tries a
   /// wider envelope, see CageOptions::MaximumEnvelopeWidenings). 0 = off.
@@ -164,6 +169,7 @@ struct EnvelopeResult
   std::size_t NumberOfActivePoints = 0;  ///< input points flagged active
   std::size_t NumberOfActiveSamples = 0; ///< size of the active set A (samples)
   std::size_t AmplifiedVoxels = 0;       ///< voxels where phi > 1.001
+  std::size_t FieldTriangles = 0;        ///< triangles the kept envelope's field came from (ClusteredField)
   double ActivePointSeconds = 0.0;       ///< active points + g_A
   double AmplificationSeconds = 0.0;     ///< xi -> phi xi on the grid (included in DistanceFieldSeconds)
   double WindingSeconds = 0.0;           ///< winding-number sign (included in DistanceFieldSeconds)

@@ -34,6 +34,7 @@ struct IsosurfaceOutput
   std::size_t InsideVoxels = 0;       ///< of those, the ones found inside
   double AcceptedAdaptivity = 0.0;    ///< with a judge: the adaptivity of the accepted surface
   int Repairs = 0;                    ///< with a judge: re-extractions with a larger no-adaptivity region
+  std::size_t FieldTriangles = 0;     ///< the triangles the distance field was computed from
 };
 
 /// Judges an extracted surface: true accepts it. Otherwise `repairNear` may receive points (unit-
@@ -63,7 +64,7 @@ using SurfaceJudge = std::function<bool(const TriangleMesh& surface, double adap
 IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSize, double iso, bool keepField,
   Progress* progress, const std::vector<double>& adaptivities = { 0.0 }, const ActivePoints* amplification = nullptr,
   const SurfaceJudge* judge = nullptr, int maxRepairs = 3, SignMode sign = SignMode::FloodFill,
-  const TriangleTree* windingTree = nullptr);
+  const TriangleTree* windingTree = nullptr, bool clusteredField = false);
 
 /// How many isosurface extractions a cancel has abandoned since the process started (each ends
 /// on its own thread and frees its memory; the process waits for them at exit). For tests and

@@ -142,6 +142,7 @@ CageResult generateOnce(const PreparedInput& prepared, const CageOptions& option
   result.TopologyWarning = env.TopologyWarning;
   result.TopologyRepairs = env.TopologyRepairs;
   result.TopologyRepairLog = env.TopologyRepairLog;
+  result.FieldTriangles = static_cast<long long>(env.FieldTriangles);
   result.ClearanceUsedRelative = env.ClearanceUsed;
   result.TotalSeconds = seconds(start);
   if (env.TooComplex)

@@ -130,6 +130,9 @@ struct CageResult
   int IsoValuesSkipped = 0;   ///< isovalues the probes ruled out (included in EnvelopeWidenings)
   double ProbeSeconds = 0.0;  ///< time of the probes
   int EnvelopeAttempts = 0;   ///< envelopes built on the requested grid (each one full run)
+  /// Triangles the envelope's distance field was computed from: fewer than the input's when it
+  /// came from a clustered proxy (EnvelopeOptions::ClusteredField).
+  long long FieldTriangles = 0;
   /// A provisional result (CageOptions::DeferEnvelopeVerification): its envelope is not verified
   /// yet, nor its cage; never returned by generateCage.
   bool VerificationDeferred = false;

@@ -217,6 +217,8 @@ ResultTable cageResults(const CageResult& r)
         "isovalues the probes ruled out (too many parts and handles for the target; counted in EnvelopeWidenings)"),
       real("ProbeTime", r.ProbeSeconds, "s", "the coarse-grid probes"),
       integer("EnvelopeAttempts", r.EnvelopeAttempts, "count", "envelopes built on the requested grid"),
+      integer("FieldTriangles", r.FieldTriangles, "count",
+        "triangles the envelope's distance field came from (fewer than the input's: a clustered proxy)"),
       integer("TopologyRepairs", r.TopologyRepairs, "count",
         "envelopes rebuilt (gap rule, stronger amplification, finer grid) to keep the input's topology"),
       text("TopologyRepairLog", r.TopologyRepairLog, "what each topology repair round did and found"),

@@ -309,6 +309,60 @@ TEST(CoarseFirst, KeepsWhatTheRequestedGridKeeps)
   EXPECT_GE(between, 1) << "no torus kept its handle on the grid between the coarse and the requested one";
 }
 
+// The distance field from a clustered proxy (EnvelopeOptions::ClusteredField): a torus whose
+// triangles are several times smaller than the voxels of an isovalue of 0.05 gets its field from
+// far fewer triangles, and an envelope that the exact referee accepts, with the same topology and
+// as tight (its farthest point from the input within 15% of the exact field's). Not where the
+// proxy would drop less than a tenth of the triangles, not with a kept field (it is displayed),
+// not with amplification.
+TEST(ClusteredField, DenseInputGetsAVerifiedEnvelopeFromFewerTriangles)
+{
+  const TriangleMesh torus = makeTorus(Vec3(0.0, 0.0, 0.0), 0.65, 0.3, 256, 128);
+  EnvelopeOptions on;
+  on.IsoValue = 0.05;
+  on.UseActivePoints = false;
+  EnvelopeOptions off = on;
+  off.ClusteredField = false;
+  const EnvelopeResult a = buildEnvelope(torus, on);
+  const EnvelopeResult b = buildEnvelope(torus, off);
+  ASSERT_EQ(a.State, Status::Ok) << a.Message;
+  ASSERT_EQ(b.State, Status::Ok) << b.Message;
+  const auto farthest = [](const EnvelopeResult& r) {
+    return *std::max_element(r.DistanceToInput.begin(), r.DistanceToInput.end());
+  };
+  std::cout << "[ cluster  ] torus of " << torus.Triangles.size() << " triangles: field from " << a.FieldTriangles
+            << " (voxel " << a.VoxelSizeUsed << "), envelope " << a.Envelope.Triangles.size() << " triangles, farthest "
+            << farthest(a) << "; exact field: " << b.FieldTriangles << ", envelope " << b.Envelope.Triangles.size()
+            << " triangles, farthest " << farthest(b) << "\n";
+  EXPECT_LT(a.FieldTriangles, torus.Triangles.size() / 2);
+  EXPECT_EQ(b.FieldTriangles, torus.Triangles.size());
+  EXPECT_EQ(a.Genus, 1);
+  EXPECT_EQ(a.Components, 1);
+  EXPECT_LE(farthest(a), 1.15 * farthest(b));
+  expectEncloses(torus, a.Envelope, on.clearance(), 2.0 * on.IsoValue, "torus, clustered field");
+
+  // a kept field stays exact
+  EnvelopeOptions kept = on;
+  kept.KeepDistanceField = true;
+  const EnvelopeResult k = buildEnvelope(torus, kept);
+  ASSERT_EQ(k.State, Status::Ok) << k.Message;
+  EXPECT_EQ(k.FieldTriangles, torus.Triangles.size());
+
+  // a coarse input keeps the exact field (and its envelope)
+  const TriangleMesh coarse = makeTorus(Vec3(0.0, 0.0, 0.0), 0.65, 0.3, 48, 24);
+  const EnvelopeResult c = buildEnvelope(coarse, on);
+  ASSERT_EQ(c.State, Status::Ok) << c.Message;
+  EXPECT_EQ(c.FieldTriangles, coarse.Triangles.size());
+
+  // with amplification the field comes from the whole refined surface
+  const TriangleMesh builtin = makeBuiltinShape(0.012, 3);
+  EnvelopeOptions amplified;
+  const EnvelopeResult d = buildEnvelope(builtin, amplified);
+  ASSERT_EQ(d.State, Status::Ok) << d.Message;
+  ASSERT_GT(d.NumberOfActivePoints, 0u);
+  EXPECT_GE(d.FieldTriangles, builtin.Triangles.size());
+}
+
 // The adaptive envelope's cut corners mended (EnvelopeOptions::LiftCutCorners): on a grid as
 // coarse as the isovalue with a high adaptivity, the merged polygons around the rounded edges of
 // an offset box and around a thin ring cut into the clearance. Mended, the envelope passes verification
