@@ -754,20 +754,31 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
       {
         return false; // computeIsosurface reports the cancel
       }
+      // the envelope's parts and genus, computed once when first needed
+      std::vector<int> comp;
+      int parts = -1, g = 0;
+      bool usable = false;
+      const auto topology = [&]() {
+        if (parts < 0)
+        {
+          parts = triangleComponents(envelope, comp);
+          usable = checkTriangleMesh(envelope).usable();
+          g = usable ? genus(envelope) : 0;
+        }
+      };
       if (coarseLevel && result.InputClosed)
       {
         // fused on the coarse grid, or too few points for the target (judged before the costly
         // mending and verification; the accepted envelope is checked again below): the
         // requested grid decides
-        std::vector<int> comp;
+        if (envelope.Points.size() >= options.CoarseMinimumPoints)
+          topology();
         if (envelope.Points.size() < options.CoarseMinimumPoints ||
-          (checkTriangleMesh(envelope).usable() &&
-            (triangleComponents(envelope, comp) != result.InputComponents || genus(envelope) != result.InputGenus)))
+          (usable && (parts != result.InputComponents || g != result.InputGenus)))
         {
           if (std::getenv("SDFCAGE_DEBUG_ENVELOPE"))
             std::fprintf(stderr, "coarse grid rejected: %zu points, %d parts, genus %d (input %d, %d)\n",
-              envelope.Points.size(), triangleComponents(envelope, comp), genus(envelope), result.InputComponents,
-              result.InputGenus);
+              envelope.Points.size(), parts, g, result.InputComponents, result.InputGenus);
           coarseRejected = true;
           return true; // stops the extraction
         }
@@ -775,9 +786,7 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
       if (options.VertexBudget > 0)
       {
         // too many parts and handles for the target: not worth verifying (a wider one follows)
-        std::vector<int> comp;
-        const int parts = triangleComponents(envelope, comp);
-        const int g = checkTriangleMesh(envelope).usable() ? genus(envelope) : 0;
+        topology();
         if (minimumCageVertices(parts, g) > options.VertexBudget && coarseLevel)
         {
           coarseRejected = true; // the requested grid may separate what the coarse one fused

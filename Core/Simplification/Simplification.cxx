@@ -155,7 +155,8 @@ public:
       const int parts = triangleComponents(mesh, component);
       if (parts > 1 && parts <= 16)
       {
-        const double room = std::min(o.PartClearance, 0.95 * distanceBetweenParts(mesh, o.PartClearance / 0.95));
+        const double room =
+          std::min(o.PartClearance, 0.95 * distanceBetweenParts(mesh, o.PartClearance / 0.95, component, parts));
         if (room > o.selfClearance())
         {
           Part.assign(P.size(), 0);

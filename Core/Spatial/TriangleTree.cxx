@@ -513,6 +513,11 @@ double distanceBetweenParts(const TriangleMesh& mesh, double limit)
 {
   std::vector<int> component;
   const int parts = triangleComponents(mesh, component);
+  return distanceBetweenParts(mesh, limit, component, parts);
+}
+
+double distanceBetweenParts(const TriangleMesh& mesh, double limit, const std::vector<int>& component, int parts)
+{
   double gap = limit;
   for (int c = 0; c + 1 < parts; ++c)
   {

@@ -15,6 +15,8 @@ class Progress;
 /// The smallest distance between two parts of `mesh` when it is below `limit` (exact triangle
 /// distances), else `limit` (also for a mesh of one part).
 double distanceBetweenParts(const TriangleMesh& mesh, double limit);
+/// The same with the parts known: `component` per triangle and their number (triangleComponents).
+double distanceBetweenParts(const TriangleMesh& mesh, double limit, const std::vector<int>& component, int parts);
 
 class TriangleTree
 {
