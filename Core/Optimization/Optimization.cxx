@@ -1625,6 +1625,51 @@ double sampledHausdorff(const TriangleMesh& cage, const TriangleTree& tree, Prog
   }
   return lower;
 }
+/// Area fraction of the cage whose distance to the input lies within [lo, hi]: every triangle
+/// cut into 4^3 = 64 by three rounds of midpoint subdivision, each piece judged at its centroid
+/// (exact distances through the input's tree); per triangle in parallel, summed in order.
+double areaWithinBand(const TriangleMesh& cage, const TriangleTree& tree, double lo, double hi)
+{
+  const std::size_t n = cage.Triangles.size();
+  std::vector<double> inside(n, 0.0), area(n, 0.0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16), [&](const tbb::blocked_range<std::size_t>& range) {
+    std::vector<std::array<Vec3, 3>> pieces, next;
+    for (std::size_t f = range.begin(); f != range.end(); ++f)
+    {
+      const Triangle& t = cage.Triangles[f];
+      pieces.assign(1, { cage.Points[t[0]], cage.Points[t[1]], cage.Points[t[2]] });
+      for (int round = 0; round < 3; ++round)
+      {
+        next.clear();
+        for (const auto& q : pieces)
+        {
+          const Vec3 ab = 0.5 * (q[0] + q[1]), bc = 0.5 * (q[1] + q[2]), ca = 0.5 * (q[2] + q[0]);
+          next.push_back({ q[0], ab, ca });
+          next.push_back({ ab, q[1], bc });
+          next.push_back({ ca, bc, q[2] });
+          next.push_back({ ab, bc, ca });
+        }
+        pieces.swap(next);
+      }
+      for (const auto& q : pieces)
+      {
+        const double a = 0.5 * (q[1] - q[0]).cross(q[2] - q[0]).norm();
+        const double d = tree.distance((q[0] + q[1] + q[2]) / 3.0);
+        area[f] += a;
+        if (d >= lo && d <= hi)
+          inside[f] += a;
+      }
+    }
+  });
+  double in = 0.0, all = 0.0;
+  for (std::size_t f = 0; f < n; ++f)
+  {
+    in += inside[f];
+    all += area[f];
+  }
+  return all > 0.0 ? in / all : 0.0;
+}
+
 double smallAngleFraction(const TriangleMesh& cage, double angle)
 {
   long long n = 0;
@@ -1740,6 +1785,8 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
   const bool mipsMode = options.Energy == CageEnergy::MIPS;
   r.SmallAnglesBefore = smallAngleFraction(cage, options.TargetMinimumAngle);
   r.HausdorffBefore = sampledHausdorff(cage, inputTree, progress);
+  if (!mipsMode)
+    r.SpacingBandBefore = areaWithinBand(cage, inputTree, 0.8 * options.TargetSpacing, 1.2 * options.TargetSpacing);
   if (progressCancelled(progress))
   {
     // the given cage, verified above (its distances are not measured again)
@@ -1890,6 +1937,8 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
   r.SmallAnglesAfter = smallAngleFraction(r.Cage, options.TargetMinimumAngle);
   // after a cancel, bounded by the verification's grace (then a lower bound)
   r.HausdorffAfter = sampledHausdorff(r.Cage, inputTree, progress ? &grace : nullptr);
+  if (!mipsMode)
+    r.SpacingBandAfter = areaWithinBand(r.Cage, inputTree, 0.8 * options.TargetSpacing, 1.2 * options.TargetSpacing);
   if (progress && grace.expired() && r.Message.find("lower bound") == std::string::npos)
     r.Message += std::string(r.Message.empty() ? "" : "; ") + "HausdorffAfter is a lower bound (cut short by the cancel)";
   r.State = cancelled ? Status::Cancelled : Status::Ok;

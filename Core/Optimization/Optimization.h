@@ -117,6 +117,10 @@ struct OptimizeResult
   /// HausdorffFactor x before (MIPS; 0: off).
   double HausdorffBefore = 0.0;
   double HausdorffAfter = 0.0;
+  /// Spacing energy: the area fraction of the cage whose distance to the input lies within
+  /// TargetSpacing +- 20% (each triangle judged at the centroids of its 64 midpoint pieces).
+  double SpacingBandBefore = 0.0;
+  double SpacingBandAfter = 0.0;
   double HausdorffBudget = 0.0;
   double SmallAnglesBefore = 0.0; ///< fraction of triangle angles below TargetMinimumAngle (MIPS)
   double SmallAnglesAfter = 0.0;

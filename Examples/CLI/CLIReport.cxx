@@ -307,6 +307,10 @@ void printSummary(std::ostream& os, const RunReport& r)
        << "              min angle " << number(r.number("MinimumAngleBefore")) << " -> "
        << number(r.number("MinimumAngleAfter")) << " deg, Hausdorff cage->input " << number(r.number("HausdorffBefore"))
        << " -> " << number(r.number("HausdorffAfter")) << " relative\n";
+    if (r.Optimize == "spacing")
+      os << "              area within spacing " << number(r.TargetSpacing)
+         << " +- 20%: " << number(r.number("SpacingBandBefore")) << "% -> " << number(r.number("SpacingBandAfter"))
+         << "%\n";
   }
   os << "clearance   : " << number(r.number("MeasuredClearance"))
      << " (input units) = " << number(r.number("MeasuredClearanceRelative"))

@@ -10,6 +10,7 @@
 #include "Common/Progress.h"
 #include "Mesh/Shapes.h"
 #include "Spatial/TriangleTree.h"
+#include "SpacingBand.h"
 
 #include <gtest/gtest.h>
 
@@ -233,6 +234,14 @@ TEST(Optimization, SpacingConcentratesAroundTarget)
             << std::hypot(m1, s1) << "\n";
   EXPECT_LT(std::abs(m1), 0.5 * std::abs(m0));
   EXPECT_LT(std::hypot(m1, s1), 0.5 * std::hypot(m0, s0));
+  // the reported area within h +- 20% agrees with the test's own measure (256 pieces a triangle)
+  const double b0 = bandFraction(n.toUnit(cage.Cage), tree, 0.8 * h, 1.2 * h);
+  const double b1 = bandFraction(n.toUnit(r.Cage), tree, 0.8 * h, 1.2 * h);
+  std::cout << "[ spacing  ] area within h +- 20%: reported " << r.SpacingBandBefore << " -> " << r.SpacingBandAfter
+            << ", measured here " << b0 << " -> " << b1 << "\n";
+  EXPECT_NEAR(r.SpacingBandBefore, b0, 0.03);
+  EXPECT_NEAR(r.SpacingBandAfter, b1, 0.03);
+  EXPECT_GT(r.SpacingBandAfter, r.SpacingBandBefore + 0.2);
 }
 
 TEST(Optimization, CCDCutsAMoveThroughATriangleShort)

@@ -118,6 +118,7 @@ TEST(Tight, Spacing)
     std::cout << "[ spacing  ] " << gArgs.Mesh << ": " << 100 * fraction << "% of the area within h +- 20% (h = " << h
               << "), " << r.Sweeps << " sweeps, " << r.Seconds << " s\n";
     EXPECT_GE(fraction, 0.9) << "h = " << h;
+    EXPECT_NEAR(r.SpacingBandAfter, fraction, 0.03) << "the reported area within the band, h = " << h;
   }
 }
 
