@@ -57,6 +57,13 @@ struct OptimizeOptions
   double Clearance = 0.0;
   /// Distance kept between cage triangles that share no vertex; 0 = δ / 4 (as the simplifier).
   double SelfClearance = 0.0;
+  /// The parts (connected components) of the cage never come closer to each other than in the
+  /// given cage (measured up to MaximumPartRoom): the room the nested cages' next level passes
+  /// through (SimplifyOptions::PartClearance). The pipeline sets it when the simplifier kept
+  /// room. Up to 16 parts.
+  bool KeepPartsApart = false;
+  /// KeepPartsApart: parts farther apart than this (unit-sphere units) only keep this distance.
+  double MaximumPartRoom = 0.1;
   /// A changed triangle's quality 4 sqrt(3) A / sum(l^2) (1 equilateral) must stay at least
   /// min(this, its quality before the change).
   double MinimumTriangleQuality = 0.02;
@@ -99,6 +106,7 @@ struct OptimizeResult
   double EnergyAfter = 0.0;                    ///< E_quality of the result
   double MinimumClearance = 0.0;               ///< measured exact minimum distance to the input
   double ClearanceUsed = 0.0;                  ///< δ actually enforced
+  double PartClearanceUsed = 0.0;              ///< room kept between the cage's parts (0: none)
   double MinimumAngleBefore = 0.0;             ///< degrees
   double MinimumAngleAfter = 0.0;              ///< degrees
   long long Moves = 0;                         ///< accepted descent steps

@@ -310,6 +310,7 @@ CageResult generateOnce(const PreparedInput& prepared, const CageOptions& option
     if (options.Optimize && !result.Simplification.Cancelled && !progressCancelled(progress))
     {
       OptimizeOptions oo = options.Optimization;
+      oo.KeepPartsApart = result.Simplification.PartClearanceUsed > 0; // the nested levels' room
       oo.Clearance = so.Clearance;
       result.Optimization = optimizeCage(result.Simplification.Cage, unit, tree, oo, progress, 0.96, 1.0);
       result.OptimizationSeconds = result.Optimization.Seconds;

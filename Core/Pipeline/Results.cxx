@@ -121,6 +121,9 @@ ResultTable optimizationStatistics(const OptimizeResult& o)
     real("SpacingBandBefore", 100 * o.SpacingBandBefore, "percent",
       "spacing energy: area of the cage at TargetSpacing +- 20% from the input, before the optimization"),
     real("SpacingBandAfter", 100 * o.SpacingBandAfter, "percent", "the same after the optimization"),
+    real("OptimizationPartRoom", o.PartClearanceUsed, "relative",
+      "distance the optimization kept between the cage's parts: as the simplified cage had them (nested levels; "
+      "0: none)"),
     integer("NumberOfMoves", o.Moves, "count", "accepted vertex relocations"),
     integer("NumberOfFlips", o.Flips, "count", "accepted edge flips"),
     integer("NumberOfCollapses", o.Collapses, "count",

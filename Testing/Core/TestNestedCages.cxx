@@ -127,9 +127,10 @@ protected:
 // through three levels, each level's parts keep the room it reports (measured by the referee),
 // and the counts are reached. Without the room the 40-vertex level fused (measured: 96 vertices,
 // one part).
-TEST(NestedCages, RoomBetweenPartsKeepsThemApartLevelAfterLevel)
+namespace
 {
-  const double gap = 0.08;
+TriangleMesh twoSpheres(double gap)
+{
   TriangleMesh shape = makeSphere(Vec3(-0.5 - gap / 2, 0, 0), 0.5, 64, 32);
   const TriangleMesh other = makeSphere(Vec3(0.5 + gap / 2, 0, 0), 0.5, 64, 32);
   const int offset = static_cast<int>(shape.Points.size());
@@ -140,19 +141,30 @@ TEST(NestedCages, RoomBetweenPartsKeepsThemApartLevelAfterLevel)
       v += offset;
     shape.Triangles.push_back(t);
   }
-  const NestedCageResult r = generateNestedCages(PolygonMesh::fromTriangles(shape), { 400, 100, 40 }, CageOptions());
-  ASSERT_EQ(r.State, Status::Ok) << r.Message;
-  ASSERT_EQ(r.Levels.size(), 3u);
+  return shape;
+}
+
+// Each level encloses the one inside it without self-intersection, has two parts, and (all but
+// the last) keeps its reported room between them, all measured by the referee.
+void expectLevelsApart(const TriangleMesh& shape, const NestedCageResult& r, bool optimized)
+{
   for (std::size_t k = 0; k < r.Levels.size(); ++k)
   {
     const NestedLevel& level = r.Levels[k];
     const TriangleMesh& cage = level.Result.Cage;
     const TriangleMesh& inside = k == 0 ? shape : r.Levels[k - 1].Result.Cage;
     const double room = level.Result.Normalize.lengthToInput(level.Result.Simplification.PartClearanceUsed);
-    std::printf("level %zu: %d vertices, %d parts, room %.4g (input units)\n", k, level.Result.VerticesReached,
-      level.CageComponents, room);
+    std::printf("level %zu: %d vertices, %d parts, room %.4g (input units), optimized %d\n", k,
+      level.Result.VerticesReached, level.CageComponents, room, level.Result.Optimized ? 1 : 0);
     EXPECT_TRUE(level.Result.TargetReached) << level.Result.StopReason;
     EXPECT_EQ(level.CageComponents, 2) << "level " << k;
+    if (optimized)
+    {
+      EXPECT_TRUE(level.Result.Optimized) << "level " << k << ": " << level.Result.Optimization.Message;
+      EXPECT_GT(level.Result.Optimization.Moves, 0) << "level " << k;
+      // the optimizer's room: what the simplified cage kept, at least the simplifier's
+      EXPECT_GE(level.Result.Optimization.PartClearanceUsed, level.Result.Simplification.PartClearanceUsed);
+    }
     const exact::ExactReport in = exact::exactCheck(inside, cage, 0.0);
     EXPECT_TRUE(in.Encloses) << "level " << k << ": " << exact::toJson(in);
     EXPECT_EQ(in.SelfIntersections, 0);
@@ -172,7 +184,39 @@ TEST(NestedCages, RoomBetweenPartsKeepsThemApartLevelAfterLevel)
     for (std::size_t f = 0; f < cage.Triangles.size(); ++f)
       (part[f] == part[0] ? a : b).Triangles.push_back(cage.Triangles[f]);
     const exact::ExactReport apart = exact::exactCheck(a, b, 1.0);
+    std::printf("  parts %.4g apart\n", apart.MinimumClearance);
     EXPECT_GE(apart.MinimumClearance, 0.999 * room) << "level " << k;
+  }
+}
+} // namespace
+
+TEST(NestedCages, RoomBetweenPartsKeepsThemApartLevelAfterLevel)
+{
+  const TriangleMesh shape = twoSpheres(0.08);
+  const NestedCageResult r = generateNestedCages(PolygonMesh::fromTriangles(shape), { 400, 100, 40 }, CageOptions());
+  ASSERT_EQ(r.State, Status::Ok) << r.Message;
+  ASSERT_EQ(r.Levels.size(), 3u);
+  expectLevelsApart(shape, r, false);
+}
+
+// The optimizer keeps the parts as far apart as the simplified cage had them
+// (OptimizeOptions::KeepPartsApart). Without it, the spacing energy pushed the 400-vertex level's
+// parts to 0.00065 apart and the next level fused them (measured); with the simplifier's room
+// alone (2.2 c) the 40-vertex level fused with both energies.
+
+TEST(NestedCages, OptimizedLevelsKeepTheRoomBetweenParts)
+{
+  const TriangleMesh shape = twoSpheres(0.08);
+  for (const CageEnergy energy : { CageEnergy::MIPS, CageEnergy::Spacing })
+  {
+    SCOPED_TRACE(energyName(energy));
+    CageOptions options;
+    options.Optimize = true;
+    options.Optimization.Energy = energy;
+    const NestedCageResult r = generateNestedCages(PolygonMesh::fromTriangles(shape), { 400, 100, 40 }, options);
+    ASSERT_EQ(r.State, Status::Ok) << r.Message;
+    ASSERT_EQ(r.Levels.size(), 3u);
+    expectLevelsApart(shape, r, true);
   }
 }
 
