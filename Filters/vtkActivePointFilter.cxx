@@ -137,6 +137,7 @@ int vtkActivePointFilter::Execute(vtkPolyData* input, vtkInformationVector* outp
     options.ActivePoints.GeodesicThreshold = this->GeodesicThreshold;
     options.ActivePoints.Alpha = this->AmplificationAlpha;
     options.ActivePoints.Beta = this->AmplificationBeta;
+    options.ActivePoints.GapRatio = this->GapRatio;
     options.GenerateFields = this->GenerateDistanceFields != 0;
     options.NumberOfThreads = this->NumberOfThreads;
     FilterProgress progress(this);
@@ -165,6 +166,9 @@ int vtkActivePointFilter::Execute(vtkPolyData* input, vtkInformationVector* outp
     vtkNew<vtkUnsignedCharArray> active;
     active->SetName("ActivePoint");
     active->SetNumberOfValues(n);
+    vtkNew<vtkUnsignedCharArray> rule;
+    rule->SetName("ActiveRule");
+    rule->SetNumberOfValues(n);
     vtkNew<vtkDoubleArray> geodesic;
     geodesic->SetName("GeodesicDistanceToActive");
     geodesic->SetNumberOfValues(n);
@@ -175,10 +179,12 @@ int vtkActivePointFilter::Execute(vtkPolyData* input, vtkInformationVector* outp
     {
       const std::size_t k = static_cast<std::size_t>(i);
       active->SetValue(i, result.Active[k]);
+      rule->SetValue(i, result.ActiveRule[k]);
       geodesic->SetValue(i, result.GeodesicToActive[k]);
       phi->SetValue(i, result.Amplification[k]);
     }
     output->GetPointData()->SetScalars(active);
+    output->GetPointData()->AddArray(rule);
     output->GetPointData()->AddArray(geodesic);
     output->GetPointData()->AddArray(phi);
     if (this->GenerateDistanceFields)
@@ -211,6 +217,7 @@ void vtkActivePointFilter::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "GeodesicThreshold: " << this->GeodesicThreshold << "\n";
   os << indent << "AmplificationAlpha: " << this->AmplificationAlpha << "\n";
   os << indent << "AmplificationBeta: " << this->AmplificationBeta << "\n";
+  os << indent << "GapRatio: " << this->GapRatio << "\n";
   os << indent << "GenerateDistanceFields: " << (this->GenerateDistanceFields ? "On" : "Off") << "\n";
   os << indent << "NumberOfThreads: " << this->NumberOfThreads << "\n";
   os << indent << "Status: " << this->StatusString << "\n";

@@ -16,7 +16,8 @@
  *
  * Output 0 is the validated input (triangulated, inward components flipped, unreferenced points
  * dropped) with point arrays `ActivePoint` (1 = active; the surface is sampled with samples ActiveRadius/2 apart,
- * so a point within ActiveRadius/2 of an active sample along the surface counts as active), `GeodesicDistanceToActive` (g_A,
+ * so a point within ActiveRadius/2 of an active sample along the surface counts as active), `ActiveRule` (0 not active,
+ * 1 the paper's rule, 2 the facing-gap rule of GapRatio), `GeodesicDistanceToActive` (g_A,
  * the distance along the surface to the nearest active point, in input units, clamped at
  * 4 / AmplificationBeta in unit-sphere units) and `Amplification` (phi on the surface,
  * phi = (alpha - 1) exp(-beta^2 g_A^2) + 1). Output 1, when GenerateDistanceFields is on, is a
@@ -64,6 +65,19 @@ public:
   vtkGetMacro(ActiveRadius, double);
   vtkSetClampMacro(GeodesicThreshold, double, 1e-6, 10.0);
   vtkGetMacro(GeodesicThreshold, double);
+  ///@}
+
+  ///@{
+  /**
+   * The facing-gap rule beside the paper's (0, the default, = off): a point is also active when
+   * a point closer than ActiveRadius faces it across air and is farther from it along the
+   * surface than GapRatio times their distance plus the sample spacing. It finds parts that
+   * nearly touch close to where they join (a leg beside the body, a finger near its base), which
+   * the paper's rule misses. vtkSDFCageFilter's topology repair rounds use 3: set 3 here to see
+   * where a repair round amplifies (point array `ActiveRule` = 2).
+   */
+  vtkSetClampMacro(GapRatio, double, 0.0, 100.0);
+  vtkGetMacro(GapRatio, double);
   ///@}
 
   ///@{
@@ -139,6 +153,7 @@ protected:
   double GeodesicThreshold;
   double AmplificationAlpha;
   double AmplificationBeta;
+  double GapRatio = 0.0;
   vtkTypeBool GenerateDistanceFields = 0;
   int NumberOfThreads = 0;
 

@@ -256,6 +256,10 @@ ResultTable activePointResults(const ActivePointAnalysis& a)
     integer("NumberOfActiveSamples", static_cast<long long>(a.NumberOfActiveSamples), "count",
       "samples of the active set A on the surface"),
     integer("NumberOfSamples", static_cast<long long>(a.NumberOfSamples), "count", "samples of the surface"),
+    integer("NumberOfGapSamples", static_cast<long long>(a.NumberOfGapSamples), "count",
+      "active samples only the facing-gap rule found (GapRatio > 0; a topology repair round uses 3)"),
+    integer("NumberOfGapRulePoints", static_cast<long long>(a.NumberOfGapRulePoints), "count",
+      "input points active by the facing-gap rule (ActiveRule 2)"),
     real("ActivePointTime", a.Seconds, "s", "the whole analysis"),
   };
 }

@@ -8,6 +8,7 @@
 #include "Mesh/Normalization.h"
 #include "Mesh/Shapes.h"
 #include "Mesh/Validation.h"
+#include "Envelope/ActivePointAnalysis.h"
 #include "Envelope/ActivePoints.h"
 #include "Pipeline/CageGenerator.h"
 
@@ -176,6 +177,45 @@ TEST(GapRule, FindsTheHookTipOnly)
   const TriangleMesh tube = makeTube(roundedPolyline(line, 0.02, 0.008), 0.012, 16, Vec3(0, 1, 0));
   const ActivePoints c = computeActivePoints(tube, gap);
   EXPECT_EQ(c.NumberOfActiveSamples, 0u);
+}
+
+// What the Active Points filter shows (analyzeActivePoints, in the shape's own coordinates): with
+// the gap rule on, the hook's tip and the part below it are active by that rule (ActiveRule 2),
+// every other active point by the paper's (1); with it off no point has rule 2.
+TEST(GapRule, TheAnalysisTellsWhichRuleMadeAPointActive)
+{
+  const TriangleMesh hook = makeGapShape(GapShape::Hook, 0.008);
+  ActivePointAnalysisOptions options;
+  const ActivePointAnalysis paper = analyzeActivePoints(PolygonMesh::fromTriangles(hook), options);
+  ASSERT_EQ(paper.State, Status::Ok) << paper.Message;
+  options.ActivePoints.GapRatio = 3.0;
+  const ActivePointAnalysis gap = analyzeActivePoints(PolygonMesh::fromTriangles(hook), options);
+  ASSERT_EQ(gap.State, Status::Ok) << gap.Message;
+  EXPECT_EQ(paper.NumberOfGapSamples, 0u);
+  EXPECT_EQ(paper.NumberOfGapRulePoints, 0u);
+  EXPECT_GT(gap.NumberOfGapSamples, 0u);
+  EXPECT_GT(gap.NumberOfGapRulePoints, 0u);
+  for (const ActivePointAnalysis* a : { &paper, &gap })
+  {
+    ASSERT_EQ(a->ActiveRule.size(), a->Mesh.Points.size());
+    std::size_t byGap = 0;
+    for (std::size_t i = 0; i < a->Mesh.Points.size(); ++i)
+    {
+      EXPECT_EQ(a->ActiveRule[i] != 0, a->Active[i] != 0) << i;
+      EXPECT_LE(a->ActiveRule[i], 2);
+      if (a->ActiveRule[i] == 2)
+      {
+        ++byGap;
+        // near the tip or the part below it (the bend spans x in [-0.06, 0.02], y in [-0.02, 0.07])
+        const Vec3& p = a->Mesh.Points[i];
+        EXPECT_LT(p.y(), 0.09) << p.transpose();
+        EXPECT_GT(p.x(), -0.17) << p.transpose();
+      }
+    }
+    EXPECT_EQ(byGap, a->NumberOfGapRulePoints);
+  }
+  // the gap rule adds active points where the paper's finds none
+  EXPECT_GT(gap.NumberOfActivePoints, paper.NumberOfActivePoints);
 }
 
 // Writes the shapes for manual runs (a tool, not a test: disabled): SDFCAGE_WRITE_GAP_SHAPES=folder

@@ -980,6 +980,34 @@ int TestActivePointsBuiltin(const Context&)
   c.Check(count == filter->GetNumberOfActivePoints(), "GetNumberOfActivePoints counts them");
   c.Check(count < out->GetNumberOfPoints() / 2, "most points are not active");
   c.Check(FieldNumber(out, "NumberOfActivePoints") == static_cast<double>(count), "field data NumberOfActivePoints");
+  // which rule: the paper's for every active point while GapRatio is 0 (the default)
+  auto* rule = vtkUnsignedCharArray::SafeDownCast(out->GetPointData()->GetArray("ActiveRule"));
+  if (c.Check(rule != nullptr, "array ActiveRule"))
+  {
+    for (vtkIdType i = 0; i < out->GetNumberOfPoints(); ++i)
+    {
+      c.Check(rule->GetValue(i) == active->GetValue(i), "ActiveRule is 1 where active, 0 elsewhere (GapRatio 0)");
+    }
+  }
+  c.Check(filter->GetGapRatio() == 0.0 && FieldNumber(out, "NumberOfGapRulePoints") == 0.0,
+    "GapRatio 0 by default: no point active by the facing-gap rule");
+  {
+    // a hook whose tip nearly touches its own straight part: the paper's rule misses it, the
+    // facing-gap rule (GapRatio 3, what a topology repair round uses) finds it
+    vtkNew<vtkActivePointFilter> hook;
+    hook->SetInputData(FromTriangleMesh(sdfcage::makeGapShape(sdfcage::GapShape::Hook, 0.008)));
+    hook->SetGapRatio(3.0);
+    hook->Update();
+    vtkPolyData* h = hook->GetOutput(0);
+    auto* hookRule = vtkUnsignedCharArray::SafeDownCast(h->GetPointData()->GetArray("ActiveRule"));
+    vtkIdType byGap = 0;
+    for (vtkIdType i = 0; hookRule && i < h->GetNumberOfPoints(); ++i)
+      byGap += hookRule->GetValue(i) == 2 ? 1 : 0;
+    std::cout << "  hook with GapRatio 3: " << byGap << " points active by the facing-gap rule, "
+              << FieldNumber(h, "NumberOfGapSamples") << " gap samples\n";
+    c.Check(byGap > 0 && FieldNumber(h, "NumberOfGapRulePoints") == static_cast<double>(byGap),
+      "GapRatio 3: the hook's tip is active by the facing-gap rule (ActiveRule 2), counted in the field data");
+  }
   const sdfcage::ResultTable table = sdfcage::activePointResults(sdfcage::ActivePointAnalysis());
   c.Check(filter->GetNumberOfResults() == static_cast<int>(table.size()), "the filter has Core's active-point table");
   for (const sdfcage::ResultField& f : table)
