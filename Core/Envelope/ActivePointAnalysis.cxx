@@ -4,12 +4,10 @@
 #include "Envelope/SDFIsosurface.h"
 #include "Common/Progress.h"
 #include "Common/Threads.h"
+#include "Spatial/PointGrid.h"
 
 #include <chrono>
-#include <cmath>
-#include <cstdint>
 #include <memory>
-#include <unordered_map>
 
 namespace sdfcage
 {
@@ -74,36 +72,14 @@ ActivePointAnalysis analyzeActivePoints(
   // the sampling) in a hashed grid of cells of that size
   result.ActiveRule.assign(np, 0);
   {
-    const double reach = 0.5 * options.ActivePoints.sampleSpacing();
-    std::unordered_map<std::int64_t, std::vector<Vec3>> cells;
-    auto cellOf = [reach](double x) { return static_cast<std::int64_t>(std::floor(x / reach)); };
-    auto key = [](std::int64_t i, std::int64_t j, std::int64_t k) {
-      return ((k & 0x1FFFFF) << 42) | ((j & 0x1FFFFF) << 21) | (i & 0x1FFFFF);
-    };
+    PointGrid gapSamples(0.5 * options.ActivePoints.sampleSpacing());
     for (int id : active.GapSamples)
-    {
-      const Vec3& g = active.Surface.Points[static_cast<std::size_t>(id)];
-      cells[key(cellOf(g.x()), cellOf(g.y()), cellOf(g.z()))].push_back(g);
-    }
-    auto nearGapSample = [&](const Vec3& x) {
-      const std::int64_t ci = cellOf(x.x()), cj = cellOf(x.y()), ck = cellOf(x.z());
-      for (std::int64_t k = ck - 1; k <= ck + 1; ++k)
-        for (std::int64_t j = cj - 1; j <= cj + 1; ++j)
-          for (std::int64_t i = ci - 1; i <= ci + 1; ++i)
-          {
-            const auto it = cells.find(key(i, j, k));
-            if (it != cells.end())
-              for (const Vec3& g : it->second)
-                if ((g - x).squaredNorm() <= reach * reach)
-                  return true;
-          }
-      return false;
-    };
+      gapSamples.insert(active.Surface.Points[static_cast<std::size_t>(id)]);
     for (std::size_t i = 0; i < np; ++i)
     {
       if (!result.Active[i])
         continue;
-      result.ActiveRule[i] = !cells.empty() && nearGapSample(unit.Points[i]) ? 2 : 1;
+      result.ActiveRule[i] = !gapSamples.empty() && gapSamples.anyWithin(unit.Points[i]) ? 2 : 1;
       result.NumberOfGapRulePoints += result.ActiveRule[i] == 2 ? 1 : 0;
     }
   }

@@ -5,6 +5,7 @@
 #include "Common/Progress.h"
 #include "Quality/Verification.h"
 #include "Spatial/TriangleIndex.h"
+#include "Spatial/PointGrid.h"
 #include "Spatial/TriangleTree.h"
 #include "Mesh/EdgeKey.h"
 #include "Mesh/Validation.h"
@@ -247,34 +248,11 @@ std::size_t projectOntoAmplifiedOffset(
     for (int k = 0; k < 3; ++k)
       longestEdge = std::max(longestEdge, (amp.Surface.Points[t[k]] - amp.Surface.Points[t[(k + 1) % 3]]).norm());
   const double reach = std::sqrt(std::log(1000.0)) / amp.Beta + longestEdge;
-  std::unordered_map<std::int64_t, std::vector<Vec3>> activeCells;
-  auto cellKey = [reach](std::int64_t i, std::int64_t j, std::int64_t k) {
-    return ((k & 0x1FFFFF) << 42) | ((j & 0x1FFFFF) << 21) | (i & 0x1FFFFF);
-  };
-  auto cellOf = [reach](double x) { return static_cast<std::int64_t>(std::floor(x / reach)); };
+  PointGrid activeGrid(reach);
   for (std::size_t i = 0; i < amp.Surface.Points.size() && i < amp.Active.size(); ++i)
-  {
     if (amp.Active[i])
-    {
-      const Vec3& a = amp.Surface.Points[i];
-      activeCells[cellKey(cellOf(a.x()), cellOf(a.y()), cellOf(a.z()))].push_back(a);
-    }
-  }
-  auto nearActive = [&](const Vec3& x) {
-    const std::int64_t ci = cellOf(x.x()), cj = cellOf(x.y()), ck = cellOf(x.z());
-    for (std::int64_t k = ck - 1; k <= ck + 1; ++k)
-      for (std::int64_t j = cj - 1; j <= cj + 1; ++j)
-        for (std::int64_t i = ci - 1; i <= ci + 1; ++i)
-        {
-          const auto it = activeCells.find(cellKey(i, j, k));
-          if (it == activeCells.end())
-            continue;
-          for (const Vec3& a : it->second)
-            if ((a - x).squaredNorm() < reach * reach)
-              return true;
-        }
-    return false;
-  };
+      activeGrid.insert(amp.Surface.Points[i]);
+  auto nearActive = [&](const Vec3& x) { return activeGrid.anyWithin(x); };
   auto project = [&](std::size_t begin) {
     amplified.resize(envelope.Points.size(), 0);
     offset.resize(envelope.Points.size(), 0.0);
