@@ -825,42 +825,35 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
     // surface (dragon_vrip with cells of 0.7-1.5 voxels: 32 crossing pairs at every adaptivity,
     // the envelope falls to the next grid, 110 s instead of 10 s). Measured: armadillo_midsub4x
     // (346k triangles, 105k in the proxy of the 0.01 grid) 4.7 -> 2.4 s for its whole run.
-    bool proxied = false;
+    std::vector<Triangle> proxy;
+    std::vector<int> source; // proxy triangle -> unitMesh triangle
+    const std::vector<Triangle>* fieldTriangles = &unitMesh.Triangles;
     if (clusteredField && !keepField && !amplification)
     {
-      std::vector<Triangle> proxy;
-      std::vector<int> source;
       clusteredProxy(unitMesh, voxelSize, voxelSize, points, proxy, source);
       if (10 * proxy.size() <= 9 * unitMesh.Triangles.size())
-      {
-        proxied = true;
-        out.FieldTriangles = proxy.size();
-        order = mortonOrder(points, proxy);
-        tris.resize(order.size());
-        for (std::size_t f = 0; f < tris.size(); ++f)
-        {
-          const Triangle& t = proxy[order[f]];
-          tris[f] = openvdb::Vec3I(t[0], t[1], t[2]);
-          order[f] = source[order[f]];
-        }
-      }
+        fieldTriangles = &proxy;
+      else
+        source.clear();
     }
-    if (!proxied)
+    if (fieldTriangles == &unitMesh.Triangles)
     {
-      out.FieldTriangles = unitMesh.Triangles.size();
       points.resize(unitMesh.Points.size());
       for (std::size_t i = 0; i < points.size(); ++i)
       {
         const Vec3 p = unitMesh.Points[i] / voxelSize;
         points[i] = openvdb::Vec3s(static_cast<float>(p.x()), static_cast<float>(p.y()), static_cast<float>(p.z()));
       }
-      order = mortonOrder(points, unitMesh.Triangles);
-      tris.resize(order.size());
-      for (std::size_t f = 0; f < tris.size(); ++f)
-      {
-        const Triangle& t = unitMesh.Triangles[order[f]];
-        tris[f] = openvdb::Vec3I(t[0], t[1], t[2]);
-      }
+    }
+    out.FieldTriangles = fieldTriangles->size();
+    order = mortonOrder(points, *fieldTriangles);
+    tris.resize(order.size());
+    for (std::size_t f = 0; f < tris.size(); ++f)
+    {
+      const Triangle& t = (*fieldTriangles)[order[f]];
+      tris[f] = openvdb::Vec3I(t[0], t[1], t[2]);
+      if (!source.empty())
+        order[f] = source[order[f]];
     }
   }
   const CancellableMeshAdapter adapter(points, tris, progress, &expanding);
