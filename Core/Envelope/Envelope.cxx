@@ -1253,7 +1253,9 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
     }
     const std::string stage = "repairing topology (round " + std::to_string(round) + ")";
     progressStage(progress, stage.c_str(), 0.02, progressEnd);
+    const auto roundStart = std::chrono::steady_clock::now();
     EnvelopeResult r = buildEnvelopeOnce(unitInput, o, progress, progressEnd, inputClosed ? 1 : 0);
+    const double roundSeconds = seconds(roundStart);
     ++rounds;
     if (r.State == Status::Cancelled || progressCancelled(progress))
     {
@@ -1261,13 +1263,16 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
       r.Message = "cancelled";
       return r;
     }
+    // each round's time (a round costs about 4, then 16 times the first envelope)
+    char took[32];
+    std::snprintf(took, sizeof took, " (%.2f s)", roundSeconds);
     log << ": " << r.NumberOfActiveSamples << " active samples (" << r.GapSites.size() << " by the gap rule), ";
     if (r.State != Status::Ok)
     {
-      log << "not verified";
+      log << "not verified" << took;
       continue;
     }
-    log << "genus " << r.Genus << ", " << r.Components << " part(s)";
+    log << "genus " << r.Genus << ", " << r.Components << " part(s)" << took;
     const bool better = !topologyDiffers(r);
     if (better)
     {

@@ -102,6 +102,12 @@ void expectTopologyKept(GapShape s, double gap)
   EXPECT_EQ(r.EnvelopeGenus, r.InputGenus);
   EXPECT_EQ(r.EnvelopeComponents, r.InputComponents);
   EXPECT_TRUE(r.TopologyWarning.empty()) << r.TopologyWarning;
+  // the log gives every round's time
+  std::size_t timed = 0;
+  for (std::size_t at = r.TopologyRepairLog.find(" s)"); at != std::string::npos;
+       at = r.TopologyRepairLog.find(" s)", at + 1))
+    ++timed;
+  EXPECT_EQ(static_cast<int>(timed), r.TopologyRepairs) << r.TopologyRepairLog;
   const exact::ExactReport e = exact::exactCheck(m, r.Cage, 0.0);
   EXPECT_TRUE(e.Closed2Manifold);
   EXPECT_EQ(e.SelfIntersections, 0);
