@@ -1267,19 +1267,24 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
     char took[32];
     std::snprintf(took, sizeof took, " (%.2f s)", roundSeconds);
     log << ": " << r.NumberOfActiveSamples << " active samples (" << r.GapSites.size() << " by the gap rule), ";
+    // a round's stages count in the timings whether or not its envelope is kept
+    const auto addStageSeconds = [](EnvelopeResult& to, const EnvelopeResult& from) {
+      to.DistanceFieldSeconds += from.DistanceFieldSeconds;
+      to.IsosurfaceSeconds += from.IsosurfaceSeconds;
+      to.VerificationSeconds += from.VerificationSeconds;
+      to.ActivePointSeconds += from.ActivePointSeconds;
+    };
     if (r.State != Status::Ok)
     {
       log << "not verified" << took;
+      addStageSeconds(best, r);
       continue;
     }
     log << "genus " << r.Genus << ", " << r.Components << " part(s)" << took;
     const bool better = !topologyDiffers(r);
     if (better)
     {
-      r.DistanceFieldSeconds += best.DistanceFieldSeconds;
-      r.IsosurfaceSeconds += best.IsosurfaceSeconds;
-      r.VerificationSeconds += best.VerificationSeconds;
-      r.ActivePointSeconds += best.ActivePointSeconds;
+      addStageSeconds(r, best);
       best = std::move(r);
       break;
     }
@@ -1288,10 +1293,7 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
     {
       best.GapSites = r.GapSites;
     }
-    best.DistanceFieldSeconds += r.DistanceFieldSeconds;
-    best.IsosurfaceSeconds += r.IsosurfaceSeconds;
-    best.VerificationSeconds += r.VerificationSeconds;
-    best.ActivePointSeconds += r.ActivePointSeconds;
+    addStageSeconds(best, r);
   }
   best.TopologyRepairs = rounds;
   best.TopologyRepairLog = log.str();
