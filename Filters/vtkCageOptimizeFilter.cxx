@@ -209,6 +209,7 @@ int vtkCageOptimizeFilter::Execute(vtkPolyData* cage, vtkPolyData* source, vtkIn
     options.TargetMinimumAngle = this->TargetMinimumAngle;
     options.MaximumSweeps = this->MaximumSweeps;
     options.Clearance = this->MinimumClearance;
+    options.KeepPartsApart = this->KeepPartsApart != 0;
 
     FilterProgress progress(this);
     this->UpdateProgress(0.0);
@@ -268,6 +269,7 @@ void vtkCageOptimizeFilter::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "TargetMinimumAngle: " << this->TargetMinimumAngle << "\n";
   os << indent << "MaximumSweeps: " << this->MaximumSweeps << "\n";
   os << indent << "MinimumClearance: " << this->MinimumClearance << "\n";
+  os << indent << "KeepPartsApart: " << (this->KeepPartsApart ? "On" : "Off") << "\n";
   os << indent << "Status: " << this->StatusString << "\n";
   os << indent << "LastErrorMessage: " << this->LastErrorMessage << "\n";
   for (const sdfcage::ResultField& f : this->Internals->Results)

@@ -163,6 +163,18 @@ public:
 
   ///@{
   /**
+   * Keep the cage's parts (connected components) at least as far apart as in the given cage
+   * (measured up to 0.1, relative to the unit sphere): on for a level of a nested hierarchy, whose
+   * next level must pass between its parts. Off by default (the parts may come as close as the
+   * self clearance). The room kept is the result `OptimizationPartRoom`.
+   */
+  vtkSetMacro(KeepPartsApart, vtkTypeBool);
+  vtkGetMacro(KeepPartsApart, vtkTypeBool);
+  vtkBooleanMacro(KeepPartsApart, vtkTypeBool);
+  ///@}
+
+  ///@{
+  /**
    * Results (only valid after the filter has executed): E_quality before and after (MIPS: the
    * sum over triangles, 2 per equilateral triangle; Spacing: the integral, unit-sphere units),
    * the smallest triangle angle before and after (degrees), the measured minimum distance to
@@ -220,6 +232,7 @@ protected:
   double TargetMinimumAngle;
   int MaximumSweeps;
   double MinimumClearance;
+  vtkTypeBool KeepPartsApart = 0;
 
   // outcome of the last execution (the results are in Internals' table)
   std::string StatusString;

@@ -139,6 +139,7 @@ vtkSmartPointer<vtkPolyData> MakeSphere(double radius, int resolution);
 int TestSphere(const Context&);
 int TestOptimizeFilter(const Context&);
 int TestOptimizeTightOptions(const Context&);
+int TestOptimizeKeepsPartsApart(const Context&);
 int TestBuiltinShape(const Context&);
 int TestOpenInput(const Context&);
 int TestChooseIsoValueFirst(const Context&);

@@ -13,6 +13,13 @@
 #include "vtkStringArray.h"
 
 #include "Optimization/Optimization.h" // Core: the default options the filter must mirror
+#include "Spatial/TriangleTree.h"      // Core: distanceBetweenParts, to measure the parts' gap
+
+#include "vtkAppendPolyData.h"
+#include "vtkCellArray.h"
+#include "vtkIdList.h"
+#include "vtkSphereSource.h"
+#include "vtkTriangleFilter.h"
 
 #include <cmath>
 
@@ -208,6 +215,78 @@ int TestOptimizeTightOptions(const Context&)
     "vtkSDFCageFilter: MaximumSweeps and TargetMinimumAngle reach Core (sweeps " +
       Str(cager->GetResultNumber("NumberOfSweeps")) + ", below 45 deg " +
       Str(cager->GetResultNumber("SmallAnglesBefore")) + "%)");
+  return c.Result();
+}
+
+// KeepPartsApart: the spacing energy pushes the cages of two spheres 0.08 apart towards each
+// other; with it on the parts stay at least as far apart as in the given cage (measured with
+// Core's exact distanceBetweenParts), with it off they come closer.
+int TestOptimizeKeepsPartsApart(const Context&)
+{
+  Checker c("OptimizeKeepsPartsApart");
+  vtkNew<vtkAppendPolyData> both;
+  for (const double x : { -0.54, 0.54 })
+  {
+    vtkNew<vtkSphereSource> sphere;
+    sphere->SetCenter(x, 0, 0);
+    sphere->SetRadius(0.5);
+    sphere->SetThetaResolution(48);
+    sphere->SetPhiResolution(24);
+    both->AddInputConnection(sphere->GetOutputPort());
+  }
+  vtkNew<vtkTriangleFilter> triangles;
+  triangles->SetInputConnection(both->GetOutputPort());
+  triangles->Update();
+  vtkPolyData* spheres = triangles->GetOutput();
+  vtkNew<vtkSDFCageFilter> cager;
+  cager->SetInputData(spheres);
+  cager->SetTargetNumberOfVertices(400);
+  cager->Update();
+  vtkPolyData* cage = cager->GetOutput(0);
+  if (!c.Check(std::string(cager->GetStatusString()) == "Ok" && cage->GetNumberOfPoints() == 400,
+        "the two spheres' cage was built"))
+  {
+    return c.Result();
+  }
+  auto gap = [](vtkPolyData* pd) {
+    sdfcage::TriangleMesh m;
+    for (vtkIdType i = 0; i < pd->GetNumberOfPoints(); ++i)
+    {
+      double p[3];
+      pd->GetPoint(i, p);
+      m.Points.emplace_back(p[0], p[1], p[2]);
+    }
+    vtkNew<vtkIdList> ids;
+    for (vtkIdType f = 0; f < pd->GetNumberOfCells(); ++f)
+    {
+      pd->GetCellPoints(f, ids);
+      if (ids->GetNumberOfIds() == 3)
+        m.Triangles.push_back(
+          { static_cast<int>(ids->GetId(0)), static_cast<int>(ids->GetId(1)), static_cast<int>(ids->GetId(2)) });
+    }
+    return sdfcage::distanceBetweenParts(m, 1.0);
+  };
+  const double given = gap(cage);
+  vtkNew<vtkCageOptimizeFilter> filter;
+  c.Check(filter->GetKeepPartsApart() == 0, "KeepPartsApart is off by default");
+  filter->SetInputData(cage);
+  filter->SetSourceData(spheres);
+  filter->SetEnergy(vtkCageOptimizeFilter::SPACING);
+  filter->Update();
+  const double off = gap(filter->GetOutput());
+  c.Check(std::string(filter->GetStatusString()) == "Ok" && !filter->GetReverted(), "spacing, parts free: Ok");
+  c.Check(filter->GetResultNumber("OptimizationPartRoom") == 0, "no room kept when off");
+  filter->KeepPartsApartOn();
+  filter->Update();
+  const double on = gap(filter->GetOutput());
+  std::cout << "  parts apart: given " << given << ", optimized " << off << " (free) and " << on
+            << " (KeepPartsApart), room " << filter->GetResultNumber("OptimizationPartRoom") << " relative\n";
+  c.Check(std::string(filter->GetStatusString()) == "Ok" && !filter->GetReverted(), "spacing, parts kept apart: Ok");
+  c.Check(filter->GetOutput()->GetNumberOfPoints() == 400, "the vertex count is kept");
+  c.Check(filter->GetResultNumber("NumberOfMoves") > 0, "the optimization moved vertices");
+  c.Check(off < given, "free, the spacing energy brings the parts closer");
+  c.Check(on >= given * (1.0 - 1e-9), "KeepPartsApart: the parts are at least as far apart as given");
+  c.Check(filter->GetResultNumber("OptimizationPartRoom") > 0, "OptimizationPartRoom reports the room");
   return c.Result();
 }
 

@@ -48,6 +48,7 @@ int main(int argc, char* argv[])
     { "Sphere", TestSphere },
     { "OptimizeFilter", TestOptimizeFilter },
     { "OptimizeTightOptions", TestOptimizeTightOptions },
+    { "OptimizeKeepsPartsApart", TestOptimizeKeepsPartsApart },
     { "BuiltinShape", TestBuiltinShape },
     { "OpenInput", TestOpenInput },
     { "ChooseIsoValueFirst", TestChooseIsoValueFirst },
