@@ -79,7 +79,7 @@ ActivePointAnalysis analyzeActivePoints(
     {
       if (!result.Active[i])
         continue;
-      result.ActiveRule[i] = !gapSamples.empty() && gapSamples.anyWithin(unit.Points[i]) ? 2 : 1;
+      result.ActiveRule[i] = gapSamples.anyWithin(unit.Points[i]) ? 2 : 1;
       result.NumberOfGapRulePoints += result.ActiveRule[i] == 2 ? 1 : 0;
     }
   }

@@ -258,7 +258,8 @@ class Optimizer
 {
 public:
   Optimizer(const TriangleMesh& cage, const TriangleMesh& input, const TriangleTree& tree, const OptimizeOptions& o,
-    double clearance, double selfClearance, Progress* progress, double partRoom = 0.0)
+    double clearance, double selfClearance, Progress* progress, double partRoom = 0.0,
+    const std::vector<int>* cageComponent = nullptr)
     : Input(input)
     , Tree(tree)
     , Opt(o)
@@ -272,16 +273,15 @@ public:
   {
     P = cage.Points;
     T = cage.Triangles;
-    if (partRoom > selfClearance)
+    if (partRoom > selfClearance && cageComponent)
     {
-      // room between the parts (OptimizeOptions::PartClearance): every move and flip keeps it
-      // through the veto, which then reads that far around a change (ReadDelta)
-      std::vector<int> component;
-      triangleComponents(cage, component);
+      // room between the parts (OptimizeOptions::KeepPartsApart; `cageComponent` per triangle): every
+      // move and flip keeps it through the veto, which then reads that far around a change
+      // (ReadDelta)
       Part.assign(P.size(), 0);
       for (std::size_t f = 0; f < T.size(); ++f)
         for (int v : T[f])
-          Part[v] = component[f];
+          Part[v] = (*cageComponent)[f];
       for (LocalChangeVeto* veto : { &MoveVeto, &FlipVeto })
       {
         LocalChangePolicy p = veto->policy();
@@ -1828,9 +1828,9 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
   // onto it and the next nested level fused them; MIPS took a 100-vertex level from 0.028 to
   // 0.025 apart and the 40-vertex level after it fused.
   double partRoom = 0.0;
+  std::vector<int> component; // per cage triangle, when the room is measured
   if (options.KeepPartsApart && options.MaximumPartRoom > selfDelta)
   {
-    std::vector<int> component;
     const int parts = triangleComponents(cage, component);
     if (parts > 1 && parts <= 16)
       partRoom = distanceBetweenParts(cage, options.MaximumPartRoom, component, parts);
@@ -1838,7 +1838,7 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
       partRoom = 0.0;
   }
   r.PartClearanceUsed = partRoom;
-  Optimizer opt(cage, input, inputTree, options, delta, selfDelta, progress, partRoom);
+  Optimizer opt(cage, input, inputTree, options, delta, selfDelta, progress, partRoom, &component);
   if (mipsMode && options.HausdorffFactor > 0)
   {
     r.HausdorffBudget = options.HausdorffFactor * r.HausdorffBefore;

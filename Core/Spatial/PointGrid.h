@@ -22,7 +22,6 @@ public:
   {
   }
   void insert(const Vec3& p) { Cells[key(cell(p.x()), cell(p.y()), cell(p.z()))].push_back(p); }
-  bool empty() const { return Cells.empty(); }
   /// Whether some inserted point lies closer than the radius to x.
   bool anyWithin(const Vec3& x) const
   {
