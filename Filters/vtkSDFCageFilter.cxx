@@ -64,6 +64,7 @@ vtkSDFCageFilter::vtkSDFCageFilter()
   this->Adaptivity = defaults.Adaptivity;
   this->MaximumRefinements = defaults.MaximumRefinements;
   this->MaximumEnvelopeWidenings = cageDefaults.MaximumEnvelopeWidenings;
+  this->MaximumRelaxations = cageDefaults.MaximumRelaxations;
   this->ChooseIsoValueFirst = cageDefaults.ChooseIsoValueFirst ? 1 : 0;
   this->MaximumTopologyRepairs = defaults.MaximumTopologyRepairs;
   this->RequireTopology = defaults.RequireTopology ? 1 : 0;
@@ -183,6 +184,7 @@ sdfcage::CageOptions CageOptionsOf(vtkSDFCageFilter* f)
   options.Envelope.Adaptivity = f->GetAdaptivity();
   options.Envelope.MaximumRefinements = f->GetMaximumRefinements();
   options.MaximumEnvelopeWidenings = f->GetMaximumEnvelopeWidenings();
+  options.MaximumRelaxations = f->GetMaximumRelaxations();
   options.ChooseIsoValueFirst = f->GetChooseIsoValueFirst() != 0;
   options.Envelope.MaximumTopologyRepairs = f->GetMaximumTopologyRepairs();
   options.Envelope.RequireTopology = f->GetRequireTopology() != 0;
@@ -579,6 +581,7 @@ void vtkSDFCageFilter::PrintSelf(ostream& os, vtkIndent indent)
   os << indent << "Adaptivity: " << this->Adaptivity << "\n";
   os << indent << "MaximumRefinements: " << this->MaximumRefinements << "\n";
   os << indent << "MaximumEnvelopeWidenings: " << this->MaximumEnvelopeWidenings << "\n";
+  os << indent << "MaximumRelaxations: " << this->MaximumRelaxations << "\n";
   os << indent << "ChooseIsoValueFirst: " << (this->ChooseIsoValueFirst ? "On" : "Off") << "\n";
   os << indent << "MaximumTopologyRepairs: " << this->MaximumTopologyRepairs << "\n";
   os << indent << "RequireTopology: " << this->RequireTopology << "\n";

@@ -118,6 +118,18 @@ public:
 
   ///@{
   /**
+   * When the simplification stalls above the target (every remaining collapse would fold a
+   * sliver or crowd a neighbour), the cage so far gets one sweep of MIPS relaxation (moves and
+   * flips with every guarantee kept, within 1.4 times its distance to the input) and is simplified
+   * again, up to this many times (results Relaxations, VerticesBeforeRelaxation,
+   * RelaxationTime). 0 = off. Default 4 (Core's).
+   */
+  vtkSetClampMacro(MaximumRelaxations, int, 0, 16);
+  vtkGetMacro(MaximumRelaxations, int);
+  ///@}
+
+  ///@{
+  /**
    * Nested cages (paper §4, Fig. 9): a list of vertex counts, one cage per count, each strictly
    * enclosing the next finer one (and so the input) with the clearance. Empty (the default): one
    * cage of TargetNumberOfVertices, as before. Set like vtkContourFilter's values:
@@ -483,6 +495,7 @@ protected:
   double Adaptivity;
   int MaximumRefinements;
   int MaximumEnvelopeWidenings;
+  int MaximumRelaxations;
   vtkTypeBool ChooseIsoValueFirst;
   int MaximumTopologyRepairs;
   vtkTypeBool RequireTopology;

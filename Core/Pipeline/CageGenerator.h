@@ -58,6 +58,15 @@ struct CageOptions
   /// the late verification is built again the ordinary way (verified first, adaptivity repaired),
   /// and every cage is verified as before. The cages are the same either way.
   bool DeferEnvelopeVerification = true;
+  /// Relaxation of a stalled simplification: when the ordinary pass ends above the target (a
+  /// region of needles and slivers where every collapse would fold, cross or crowd a neighbour),
+  /// the cage so far gets one sweep of MIPS relaxation (tangential moves and edge flips, with
+  /// the optimizer's guarantees and its Hausdorff budget of 1.4 times the stalled cage's
+  /// distance; no needle repair) and is simplified again, up to this many times while a round
+  /// removes at least a sixteenth of the vertices above the target. The thorough passes run on
+  /// what is left after that. 0 = off (the thorough passes only, as before). Cages that reach
+  /// the target in their ordinary pass are not touched.
+  int MaximumRelaxations = 4;
 };
 
 struct CageResult
@@ -109,8 +118,11 @@ struct CageResult
   int VerticesReached = 0;       ///< cage vertex count
   bool TargetReached = false;    ///< VerticesReached == TargetNumberOfVertices (or target 0)
   std::string StopReason;        ///< why simplification stopped early (empty otherwise)
-  SimplifyResult Simplification; ///< statistics of the simplification
-  double SimplificationSeconds = 0.0;
+  SimplifyResult Simplification; ///< statistics of the simplification (all its rounds)
+  double SimplificationSeconds = 0.0; ///< relaxation rounds included
+  int Relaxations = 0;                ///< relaxation rounds run (CageOptions::MaximumRelaxations)
+  int VerticesBeforeRelaxation = 0;   ///< where the ordinary pass stalled (0: it did not)
+  double RelaxationSeconds = 0.0;     ///< the relaxation sweeps (part of SimplificationSeconds)
   double CageVerificationSeconds = 0.0;
   OptimizeResult Optimization; ///< statistics of the optional optimization (its Cage is cleared)
   bool Optimized = false;      ///< the optimization ran and its result is the cage

@@ -171,6 +171,11 @@ ResultTable cageResults(const CageResult& r)
     integer("CollapsesRejectedByTopology", s.RejectedTopology, "count", "... by the link condition"),
     integer("CollapsesRejectedByShape", s.RejectedShape, "count", "... by a flip or a needle"),
     integer("RelocatedPlacements", s.Relocated, "count", "infeasible placements replaced by a feasible one"),
+    integer("Relaxations", r.Relaxations, "count",
+      "MIPS relaxation sweeps of a stalled simplification (each followed by more simplification)"),
+    integer("VerticesBeforeRelaxation", r.VerticesBeforeRelaxation, "count",
+      "vertices where the ordinary simplification pass stalled above the target (0: it did not)"),
+    real("RelaxationTime", r.RelaxationSeconds, "s", "the relaxation sweeps (part of SimplificationTime)"),
     real("PartClearanceUsed", s.PartClearanceUsed, "relative",
       "room kept between the cage's parts for the next nested level (0: none asked or one part)"),
     // the optional optimization (paper 3.3)

@@ -273,6 +273,11 @@ void printSummary(std::ostream& os, const RunReport& r)
   {
     os << " (not simplified)";
   }
+  if (r.integer("Relaxations") > 0)
+  {
+    os << "; the simplification stalled at " << r.integer("VerticesBeforeRelaxation") << " vertices and went on after "
+       << r.integer("Relaxations") << " relaxation sweep(s) (" << seconds(r.number("RelaxationTime")) << ")";
+  }
   if (!r.OutputFile.empty())
   {
     os << " -> " << r.OutputFile;

@@ -107,6 +107,9 @@ void printUsage(std::ostream& os)
         "      --adaptivity A      isosurface adaptivity in [0, 1]: 0 uniform triangles, larger\n"
         "                          merges flat regions (fewer triangles); default 0.3\n"
         "      --refinements N     times the grid may be refined if verification fails, default 2\n"
+        "      --relaxations N     a simplification that stalls above the target: relax the cage\n"
+        "                          so far (one MIPS sweep, guarantees kept) and go on, up to N\n"
+        "                          times, default 4; 0 = off\n"
         "      --widenings N       inputs without a defined topology (open, soups) whose target is\n"
         "                          not reached: rebuild the envelope at twice the isovalue up to N\n"
         "                          times and keep the closest cage, default 3; 0 = off\n"
@@ -191,6 +194,7 @@ struct Options
   std::vector<int> Nested;  ///< -n N1,N2,...: nested levels, sorted finest first (empty: one cage)
   int Refinements = -1;     ///< -1 = the filter's default
   int Widenings = -1;       ///< -1 = the filter's default
+  int Relaxations = -1;     ///< -1 = the filter's default
   int TopologyRepairs = -1; ///< -1 = the filter's default
   bool RequireTopology = false;
   int CoarseFirst = -1; ///< -1 = the filter's default
@@ -429,6 +433,8 @@ bool parseBuildOption(ArgumentCursor& a, Options& o, vtkSDFCageFilter* limits)
     o.Refinements = a.integer(limits->GetMaximumRefinementsMinValue(), limits->GetMaximumRefinementsMaxValue());
   else if (arg == "--memory-limit")
     o.MemoryLimit = a.number(limits->GetMemoryLimitMinValue(), limits->GetMemoryLimitMaxValue());
+  else if (arg == "--relaxations")
+    o.Relaxations = a.integer(limits->GetMaximumRelaxationsMinValue(), limits->GetMaximumRelaxationsMaxValue());
   else if (arg == "--widenings")
     o.Widenings =
       a.integer(limits->GetMaximumEnvelopeWideningsMinValue(), limits->GetMaximumEnvelopeWideningsMaxValue());
@@ -841,6 +847,8 @@ void configureFilter(vtkSDFCageFilter* filter, const Options& o, RunReport& r)
     filter->SetMaximumRefinements(o.Refinements);
   if (o.Widenings >= 0)
     filter->SetMaximumEnvelopeWidenings(o.Widenings);
+  if (o.Relaxations >= 0)
+    filter->SetMaximumRelaxations(o.Relaxations);
   if (o.TopologyRepairs >= 0)
     filter->SetMaximumTopologyRepairs(o.TopologyRepairs);
   filter->SetRequireTopology(o.RequireTopology ? 1 : 0);
