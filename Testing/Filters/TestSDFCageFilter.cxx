@@ -349,6 +349,35 @@ int TestBuiltinShape(const Context&)
   CheckSuccessfulRun(c, filter, input);
   // A torus beside a sphere: the torus hole is far wider than the offset, so genus >= 1.
   c.Check(filter->GetEnvelopeGenus() >= 1, "the torus' hole survives (genus >= 1)");
+
+  // MaximumRelaxations (default = Core's): at 17 vertices the simplification stalls (at 82) and
+  // is relaxed and goes on, to fewer vertices than without relaxation; the field data says so
+  c.Check(filter->GetMaximumRelaxations() == sdfcage::CageOptions().MaximumRelaxations,
+    "MaximumRelaxations default = Core's");
+  vtkIdType reached[2] = { 0, 0 };
+  for (const int relaxations : { 4, 0 })
+  {
+    vtkNew<vtkSDFCageFilter> coarse;
+    coarse->SetInputData(input);
+    coarse->SetTargetNumberOfVertices(17);
+    coarse->SetMaximumRelaxations(relaxations);
+    coarse->Update();
+    vtkPolyData* cage = coarse->GetOutput(0);
+    reached[relaxations ? 0 : 1] = cage->GetNumberOfPoints();
+    const double rounds = FieldNumber(cage, "Relaxations");
+    const double stalled = FieldNumber(cage, "VerticesBeforeRelaxation");
+    std::cout << "  MaximumRelaxations " << relaxations << ": " << cage->GetNumberOfPoints() << " vertices, " << rounds
+              << " relaxation(s), stalled at " << stalled << "\n";
+    c.Check(FieldNumber(cage, "EnclosureVerified") == 1, "17 vertices: the cage is verified");
+    if (relaxations)
+    {
+      c.Check(rounds >= 1 && stalled > 17, "17 vertices: relaxed after the simplification stalled");
+      c.Check(FieldNumber(cage, "RelaxationTime") > 0, "17 vertices: RelaxationTime in the field data");
+    }
+    else
+      c.Check(rounds == 0 && stalled == 0, "MaximumRelaxations 0: no relaxation");
+  }
+  c.Check(reached[0] < reached[1], "the relaxed cage is closer to the target than the one without relaxation");
   return c.Result();
 }
 
