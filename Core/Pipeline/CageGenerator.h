@@ -121,7 +121,8 @@ struct CageResult
   SimplifyResult Simplification; ///< statistics of the simplification (all its rounds)
   double SimplificationSeconds = 0.0; ///< relaxation rounds included
   int Relaxations = 0;                ///< relaxation rounds run (CageOptions::MaximumRelaxations)
-  int VerticesBeforeRelaxation = 0;   ///< where the ordinary pass stalled (0: it did not)
+  int VerticesBeforeRelaxation =
+    0; ///< where the simplification stalled before relaxing (0: it did not, or no relaxation)
   double RelaxationSeconds = 0.0;     ///< the relaxation sweeps (part of SimplificationSeconds)
   double CageVerificationSeconds = 0.0;
   OptimizeResult Optimization; ///< statistics of the optional optimization (its Cage is cleared)

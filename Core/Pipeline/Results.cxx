@@ -174,7 +174,8 @@ ResultTable cageResults(const CageResult& r)
     integer("Relaxations", r.Relaxations, "count",
       "MIPS relaxation sweeps of a stalled simplification (each followed by more simplification)"),
     integer("VerticesBeforeRelaxation", r.VerticesBeforeRelaxation, "count",
-      "vertices where the ordinary simplification pass stalled above the target (0: it did not)"),
+      "vertices where the simplification stalled above the target before it was relaxed (0: it did not, or relaxation "
+      "is off)"),
     real("RelaxationTime", r.RelaxationSeconds, "s", "the relaxation sweeps (part of SimplificationTime)"),
     real("PartClearanceUsed", s.PartClearanceUsed, "relative",
       "room kept between the cage's parts for the next nested level (0: none asked or one part)"),
