@@ -119,7 +119,8 @@ public:
   ///@{
   /**
    * When the simplification stalls above the target (every remaining collapse would fold a
-   * sliver or crowd a neighbour), the cage so far gets one sweep of MIPS relaxation (moves and
+   * sliver or crowd a neighbour; far above it at once, close to it after the thorough passes),
+   * the cage so far gets one sweep of MIPS relaxation (moves and
    * flips with every guarantee kept, within 1.4 times its distance to the input) and is simplified
    * again, up to this many times (results Relaxations, VerticesBeforeRelaxation,
    * RelaxationTime). 0 = off. Default 4 (Core's).

@@ -139,17 +139,19 @@ SimplifyResult simplifyRelaxing(const TriangleMesh& envelope, const TriangleMesh
       o.PartClearance = r.PartClearanceUsed;
     add(r, simplifyEnvelope(r.Cage, tree, o, progress, &probes));
   };
+  OptimizeOptions relax;
+  relax.Energy = CageEnergy::MIPS;
+  relax.NumberOfIterations = 1;
+  relax.MaximumSweeps = 1;
+  relax.TargetMinimumAngle = 0.0; // no needle repair: the simplification removes them
+  relax.Clearance = options.Clearance;
+  relax.SelfClearance = options.selfClearance();
+  SimplifyOptions again = options;
+  again.GiveUpAbove = closeTo;
   // (the rounds and the thorough passes report at the end of the ordinary pass's span, where a
   // stalled pass leaves the progress; cancels are checked as everywhere)
   for (int round = 0; round < maximumRelaxations && !r.TargetReached; ++round)
   {
-    OptimizeOptions relax;
-    relax.Energy = CageEnergy::MIPS;
-    relax.NumberOfIterations = 1;
-    relax.MaximumSweeps = 1;
-    relax.TargetMinimumAngle = 0.0; // no needle repair: the simplification removes them
-    relax.Clearance = options.Clearance;
-    relax.SelfClearance = options.selfClearance();
     relax.KeepPartsApart = r.PartClearanceUsed > 0;
     const auto t0 = std::chrono::steady_clock::now();
     OptimizeResult o = optimizeCage(r.Cage, unit, tree, relax, progress, 0.95, 0.95);
@@ -166,8 +168,6 @@ SimplifyResult simplifyRelaxing(const TriangleMesh& envelope, const TriangleMesh
     r.Cage = std::move(o.Cage);
     progressStage(progress, "simplifying", 0.95, 0.95);
     const int before = r.VerticesReached;
-    SimplifyOptions again = options;
-    again.GiveUpAbove = closeTo;
     simplifyAgain(again);
     if (r.Cancelled || 16 * (before - r.VerticesReached) < before - target)
       break;

@@ -58,14 +58,16 @@ struct CageOptions
   /// the late verification is built again the ordinary way (verified first, adaptivity repaired),
   /// and every cage is verified as before. The cages are the same either way.
   bool DeferEnvelopeVerification = true;
-  /// Relaxation of a stalled simplification: when the ordinary pass ends above the target (a
-  /// region of needles and slivers where every collapse would fold, cross or crowd a neighbour),
-  /// the cage so far gets one sweep of MIPS relaxation (tangential moves and edge flips, with
-  /// the optimizer's guarantees and its Hausdorff budget of 1.4 times the stalled cage's
-  /// distance; no needle repair) and is simplified again, up to this many times while a round
-  /// removes at least a sixteenth of the vertices above the target. The thorough passes run on
-  /// what is left after that. 0 = off (the thorough passes only, as before). Cages that reach
-  /// the target in their ordinary pass are not touched.
+  /// Relaxation of a stalled simplification: when the ordinary pass ends more than
+  /// max(64, target / 4) vertices above the target (a region of needles and slivers where every
+  /// collapse would fold, cross or crowd a neighbour), the cage so far gets one sweep of MIPS
+  /// relaxation (tangential moves and edge flips, with the optimizer's guarantees and its
+  /// Hausdorff budget of 1.4 times the stalled cage's distance; no needle repair) and is
+  /// simplified again, up to this many times while a round removes at least a sixteenth of the
+  /// vertices above the target; the thorough passes run on what is left. A pass that ends closer
+  /// to the target runs the thorough passes first, and is relaxed only if they end above it.
+  /// 0 = off (the thorough passes only, as before). Cages that reach the target in their
+  /// ordinary pass are not touched.
   int MaximumRelaxations = 4;
 };
 
