@@ -760,6 +760,10 @@ std::string ActivePointOptions::validate() const
   {
     s << "GapRatio must be >= 0 (got " << GapRatio << "). ";
   }
+  if (!(AdaptivityOffFraction >= 0 && AdaptivityOffFraction <= 1))
+  {
+    s << "AdaptivityOffFraction must be in [0, 1] (got " << AdaptivityOffFraction << "). ";
+  }
   std::string r = s.str();
   if (!r.empty())
   {
@@ -908,6 +912,7 @@ ActivePoints computeActivePoints(const TriangleMesh& unitInput, const ActivePoin
   ActivePoints result;
   result.Alpha = options.Alpha;
   result.Beta = options.Beta;
+  result.AdaptivityOffFraction = options.AdaptivityOffFraction;
   result.Cutoff = options.geodesicCutoff();
   result.NumberOfInputPoints = unitInput.Points.size();
   const double spacing = options.sampleSpacing();

@@ -40,6 +40,10 @@ struct ActivePointOptions
   /// (along-surface / straight-line distance below GapRatio) stay inactive. The envelope's
   /// topology repair turns it on (3) when the envelope's genus or parts differ from the input's.
   double GapRatio = 0.0;
+  /// Adaptivity (merged polygons) is switched off in the isosurface where the amplification phi
+  /// exceeds 1 + AdaptivityOffFraction (alpha - 1): there the envelope lies closest to the input
+  /// (see amplify in SDFIsosurface.cxx). The topology repair rounds raise it to 0.6.
+  double AdaptivityOffFraction = 0.3;
 
   double sampleSpacing() const { return SampleSpacing > 0 ? SampleSpacing : Radius; }
   /// Beyond this geodesic distance phi - 1 < (alpha - 1) * 1e-7: g_A is clamped there.
@@ -65,6 +69,7 @@ struct ActivePoints
   std::vector<int> GapSamples;               ///< those samples (Surface point ids)
   double Alpha = 3.0;
   double Beta = 8.0;
+  double AdaptivityOffFraction = 0.3; ///< see ActivePointOptions
   double Cutoff = 0.5;
   double Seconds = 0.0;
   bool Cancelled = false;

@@ -248,8 +248,8 @@ void clusteredProxy(const TriangleMesh& mesh, double voxelSize, double cell, std
 
 /// xi -> phi * xi on the active voxels outside the input (values in (0, maxValue]); returns the
 /// number of voxels changed by more than 1e-3 relative.
-/// `noAdapt` (a topology copy of grid's tree) keeps on only the voxels where phi > 1 + 0.3 (alpha - 1)
-/// (1.6 at alpha 3): there the envelope lies closer to the input than 0.63 c, and the margin to
+/// `noAdapt` (a topology copy of grid's tree) keeps on only the voxels where phi > 1 + f (alpha - 1),
+/// f = amp.AdaptivityOffFraction, 0.3 by default (1.6 at alpha 3): there the envelope lies closer to the input than 0.63 c, and the margin to
 /// the clearance (c/4 by default) is below half of the unamplified one. Merged polygons stay
 /// allowed where phi is smaller: the Gaussian of the amplification reaches far (phi - 1 is still
 /// 1% of alpha - 1 at 0.27 from an active point at beta 8), and with the earlier bound
@@ -262,13 +262,14 @@ void clusteredProxy(const TriangleMesh& mesh, double voxelSize, double cell, std
 /// 25.7 s, H 0.065; 0.5: 22.2 s, H 0.065, dragon_vrip 8.2 s; every envelope verified.) The meshes
 /// without active points are unchanged. Every envelope is verified as before, and one whose
 /// merged polygons fail gets adaptivity switched off around the defects (computeIsosurface).
+/// The topology repair rounds use f = 0.6 (see buildEnvelope in Envelope.cxx).
 std::size_t amplify(openvdb::FloatGrid& grid, const openvdb::Int32Grid& index, const std::vector<int>& order,
   const ActivePoints& amp, double voxelSize, float maxValue, openvdb::BoolTree& noAdapt, Progress* progress)
 {
   openvdb::tree::LeafManager<openvdb::FloatTree> leaves(grid.tree());
   std::atomic<std::size_t> changed{ 0 };
   const int triangles = static_cast<int>(amp.Surface.Triangles.size());
-  const double noAdaptPhi = 1.0 + 0.3 * (amp.Alpha - 1.0);
+  const double noAdaptPhi = 1.0 + amp.AdaptivityOffFraction * (amp.Alpha - 1.0);
   tbb::parallel_for(leaves.leafRange(), [&](const openvdb::tree::LeafManager<openvdb::FloatTree>::LeafRange& range) {
     auto acc = index.getConstAccessor();
     std::size_t local = 0;

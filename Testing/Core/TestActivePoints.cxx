@@ -184,6 +184,10 @@ TEST(ActivePoints, InvalidParametersAreNamed)
   o.Alpha = 0.5;
   EXPECT_NE(o.validate().find("AmplificationAlpha"), std::string::npos);
   EXPECT_TRUE(ActivePointOptions().validate().empty());
+  o.AdaptivityOffFraction = 1.5;
+  EXPECT_NE(o.validate().find("AdaptivityOffFraction"), std::string::npos);
+  o.AdaptivityOffFraction = -0.1;
+  EXPECT_NE(o.validate().find("AdaptivityOffFraction"), std::string::npos);
 
   const TriangleMesh input = makeBuiltinShape();
   const TriangleMesh unit = Normalization::fit(input).toUnit(input);

@@ -10,6 +10,7 @@
 #include "Mesh/Validation.h"
 #include "Envelope/ActivePointAnalysis.h"
 #include "Envelope/ActivePoints.h"
+#include "Envelope/Envelope.h"
 #include "Pipeline/CageGenerator.h"
 
 #include <gtest/gtest.h>
@@ -137,6 +138,39 @@ INSTANTIATE_TEST_SUITE_P(Gaps, GapTopology,
       static_cast<int>(std::get<1>(info.param) * 1000 + 0.5));
     return std::string(name);
   });
+
+// A repair round's finer grid merges polygons wherever its few amplified samples leave room
+// (adaptivity 1, uniform triangles only where phi > 1 + 0.6 (alpha - 1)): the hook whose tip is
+// 0.015 from its straight part takes one round, and that round's merged envelope is the one kept.
+// It is verified like any other: the referee checks it encloses the input with the clearance, and
+// it keeps the input's topology. With adaptivity off everywhere the same round gives more
+// triangles.
+TEST(TopologyRepair, FirstRoundMergesPolygonsAwayFromTheGap)
+{
+  const TriangleMesh world = makeGapShape(GapShape::Hook, 0.015);
+  const TriangleMesh unit = Normalization::fit(world).toUnit(world);
+  EnvelopeOptions o;
+  const EnvelopeResult merged = buildEnvelope(unit, o);
+  ASSERT_EQ(merged.State, Status::Ok) << merged.Message;
+  EXPECT_EQ(merged.TopologyRepairs, 1) << merged.TopologyRepairLog;
+  EXPECT_EQ(merged.Genus, 0);
+  EXPECT_EQ(merged.Components, 1);
+  EXPECT_TRUE(merged.EnclosureVerified);
+  EXPECT_DOUBLE_EQ(merged.AdaptivityUsed, 1.0);
+  EXPECT_DOUBLE_EQ(merged.VoxelSizeUsed, 0.5 * o.voxelSize());
+  const exact::ExactReport e = exact::exactCheck(unit, merged.Envelope, 0.0);
+  EXPECT_TRUE(e.Encloses);
+  EXPECT_GE(e.MinimumClearance, o.clearance() * (1.0 - 1e-9));
+  EXPECT_EQ(e.CageGenus, 0);
+  EXPECT_EQ(e.CageComponents, 1);
+
+  o.Adaptivity = 0.0;
+  const EnvelopeResult uniform = buildEnvelope(unit, o);
+  ASSERT_EQ(uniform.State, Status::Ok) << uniform.Message;
+  EXPECT_EQ(uniform.TopologyRepairs, 1) << uniform.TopologyRepairLog;
+  EXPECT_EQ(uniform.Genus, 0);
+  EXPECT_LT(2 * merged.Envelope.Triangles.size(), uniform.Envelope.Triangles.size());
+}
 
 // The strict option: with the repair off, a hook whose tip is 0.004 from its own straight part
 // fuses (a handle appears) and RequireTopology gives no cage; the default keeps a warned cage.
