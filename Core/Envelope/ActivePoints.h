@@ -42,8 +42,8 @@ struct ActivePointOptions
   double GapRatio = 0.0;
   /// Adaptivity (merged polygons) is switched off in the isosurface where the amplification phi
   /// exceeds 1 + AdaptivityOffFraction (alpha - 1): there the envelope lies closest to the input
-  /// (see amplify in SDFIsosurface.cxx). The topology repair rounds raise it to 0.6.
-  double AdaptivityOffFraction = 0.3;
+  /// (see amplify in SDFIsosurface.cxx). The first topology repair round raises it to 0.6.
+  double AdaptivityOffFraction = 0.5;
 
   double sampleSpacing() const { return SampleSpacing > 0 ? SampleSpacing : Radius; }
   /// Beyond this geodesic distance phi - 1 < (alpha - 1) * 1e-7: g_A is clamped there.
@@ -69,7 +69,7 @@ struct ActivePoints
   std::vector<int> GapSamples;               ///< those samples (Surface point ids)
   double Alpha = 3.0;
   double Beta = 8.0;
-  double AdaptivityOffFraction = 0.3; ///< see ActivePointOptions
+  double AdaptivityOffFraction = 0.5; ///< see ActivePointOptions
   double Cutoff = 0.5;
   double Seconds = 0.0;
   bool Cancelled = false;

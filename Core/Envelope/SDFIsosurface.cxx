@@ -249,20 +249,22 @@ void clusteredProxy(const TriangleMesh& mesh, double voxelSize, double cell, std
 /// xi -> phi * xi on the active voxels outside the input (values in (0, maxValue]); returns the
 /// number of voxels changed by more than 1e-3 relative.
 /// `noAdapt` (a topology copy of grid's tree) keeps on only the voxels where phi > 1 + f (alpha - 1),
-/// f = amp.AdaptivityOffFraction, 0.3 by default (1.6 at alpha 3): there the envelope lies closer to the input than 0.63 c, and the margin to
-/// the clearance (c/4 by default) is below half of the unamplified one. Merged polygons stay
-/// allowed where phi is smaller: the Gaussian of the amplification reaches far (phi - 1 is still
-/// 1% of alpha - 1 at 0.27 from an active point at beta 8), and with the earlier bound
-/// phi > 1 + 0.01 (alpha - 1) it left nothing to merge on inputs with active points all over.
-/// Measured, 500-vertex cages, `Testing/Benchmarks/cage_benchmark.py --vertices 500 --optimize
-/// none` (pipeline s, Hausdorff cage->input / mean distance of the diagonal): dragon_quartet
-/// (409 active points, repaired at voxel 0.0025) envelope 545,714 -> 320,176 triangles, 29.8 ->
-/// 22.7 s, H 0.0516 -> 0.0553, mean 0.0127 -> 0.0117; dragon_vrip (1,330) 133,344 -> 90,346
-/// triangles, 9.6 -> 8.4 s, H 0.0451 -> 0.0394, mean 0.0085 -> 0.0082. (Bound 0.1: dragon_quartet
-/// 25.7 s, H 0.065; 0.5: 22.2 s, H 0.065, dragon_vrip 8.2 s; every envelope verified.) The meshes
-/// without active points are unchanged. Every envelope is verified as before, and one whose
-/// merged polygons fail gets adaptivity switched off around the defects (computeIsosurface).
-/// The topology repair rounds use f = 0.6 (see buildEnvelope in Envelope.cxx).
+/// f = amp.AdaptivityOffFraction: 0.5 by default (phi 2 at alpha 3: there the envelope lies
+/// within c / 2 of the input, its margin to the clearance (c/4 by default) a third of the
+/// unamplified one or less), 0.6 in the first topology repair round (see buildEnvelope in
+/// Envelope.cxx). Merged polygons stay allowed where phi is smaller: the Gaussian of the
+/// amplification reaches far (phi - 1 is still 1% of alpha - 1 at 0.27 from an active point at
+/// beta 8), and with the first bound, phi > 1 + 0.01 (alpha - 1), nothing was left to merge on
+/// inputs with active points all over. Measured, 500-vertex cages (whole runs, `sdfcage --check`
+/// for the Hausdorff distance cage->input of the diagonal): f 0.01 -> 0.3, dragon_quartet (409
+/// active points, repaired at voxel 0.0025) envelope 545,714 -> 320,176 triangles, 29.8 -> 22.7
+/// s, H 0.0516 -> 0.0553; dragon_vrip (1,330) 133,344 -> 90,346 triangles, 9.6 -> 8.4 s, H 0.0451
+/// -> 0.0394. f 0.3 -> 0.5 (2026-12-05, four runs each alternating): dragon_vrip 83,882
+/// triangles, 8.9-10.3 -> 8.6-10.2 s (mean 9.66 -> 9.43 s), H 0.0394 -> 0.0325, input->cage
+/// 0.0483 -> 0.0463; the built-in shape 44,066 -> 37,056 triangles, topology kept. The meshes
+/// without active points take another path (unchanged). Every envelope is verified as before,
+/// and one whose merged polygons fail gets adaptivity switched off around the defects
+/// (computeIsosurface).
 std::size_t amplify(openvdb::FloatGrid& grid, const openvdb::Int32Grid& index, const std::vector<int>& order,
   const ActivePoints& amp, double voxelSize, float maxValue, openvdb::BoolTree& noAdapt, Progress* progress)
 {
