@@ -42,7 +42,7 @@ struct ActivePointOptions
   double GapRatio = 0.0;
   /// Adaptivity (merged polygons) is switched off in the isosurface where the amplification phi
   /// exceeds 1 + AdaptivityOffFraction (alpha - 1): there the envelope lies closest to the input
-  /// (see amplify in SDFIsosurface.cxx). The first topology repair round raises it to 0.6.
+  /// (see amplify in SDFIsosurface.cxx).
   double AdaptivityOffFraction = 0.5;
 
   double sampleSpacing() const { return SampleSpacing > 0 ? SampleSpacing : Radius; }

@@ -1250,20 +1250,21 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
     o.ActivePoints.Alpha = std::max(options.ActivePoints.Alpha, c / (1.15 * delta));
     // The first round's finer grid, with merged polygons wherever the amplification leaves room:
     // OpenVDB merges any unambiguous, manifold block at adaptivity 1 (no normal test), and the
-    // samples the round amplifies keep uniform triangles only where phi > 1 + 0.6 (alpha - 1) (the
-    // envelope within 0.4 c of the input, 0.15 c beyond the clearance at alpha 3.48). Every
-    // envelope is verified; merged polygons that fail are re-extracted without adaptivity around
-    // the defects (then at 0.3, then uniform). dragon_quartet (one round, 18 samples, voxel
-    // 0.0025; whole runs, old and new alternating): envelope 320,176 -> 150,714 triangles, 24.8 /
-    // 25.9 -> 20.1 / 18.5 s, 449-462 -> 412-415 MB, Hausdorff cage->input 0.0553 -> 0.0533 of the
-    // diagonal; adaptivity 1 alone 209,732 triangles, the bound 0.6 alone 262,296 (0.9: 116,422,
-    // the envelope then within 0.06 c of the clearance). The second round keeps the defaults: its
-    // clearance is 0.4 times the first's, and there adaptivity 1 and the bound 0.6 each cost a
+    // samples the round amplifies keep uniform triangles where phi > 1 + 0.5 (alpha - 1) (the
+    // default bound, see amplify in SDFIsosurface.cxx: the envelope within 0.45 c of the input,
+    // 0.2 c beyond the clearance at alpha 3.48). Every envelope is verified; merged polygons that
+    // fail are re-extracted without adaptivity around the defects (then at 0.3, then uniform).
+    // dragon_quartet (one round, 18 samples, voxel 0.0025; whole runs): envelope 320,176 ->
+    // 166,378 triangles, 24.8 / 25.9 -> 19.1 / 19.4 s, about 450 -> 427 MB, Hausdorff cage->input
+    // 0.0553 -> 0.0495 of the diagonal. (Adaptivity 0.3 with the bound 0.6: 262,296
+    // triangles; adaptivity 1 with the bound 0.6: 150,714 and 18.3-19.4 s, but its cage's MIPS
+    // optimization stalls at 12.9 degrees, 15.04 with the bound 0.5; adaptivity 0.9 or 0.99:
+    // 190-193k, OpenVDB's normal test merges far less than none.) The second round keeps the
+    // requested adaptivity: its clearance is 0.4 times the first's, and there adaptivity 1 costs a
     // failed extraction (three parts 0.004 apart: 8.5 -> 9.7 s).
     if (round == 1 && options.Adaptivity > 0.0)
     {
       o.Adaptivity = 1.0;
-      o.ActivePoints.AdaptivityOffFraction = std::max(options.ActivePoints.AdaptivityOffFraction, 0.6);
     }
     const double voxels = area / (o.VoxelSize * o.VoxelSize);
     log << "; round " << round << ": voxel " << o.VoxelSize << ", alpha " << o.ActivePoints.Alpha << ", clearance "

@@ -251,8 +251,8 @@ void clusteredProxy(const TriangleMesh& mesh, double voxelSize, double cell, std
 /// `noAdapt` (a topology copy of grid's tree) keeps on only the voxels where phi > 1 + f (alpha - 1),
 /// f = amp.AdaptivityOffFraction: 0.5 by default (phi 2 at alpha 3: there the envelope lies
 /// within c / 2 of the input, its margin to the clearance (c/4 by default) a third of the
-/// unamplified one or less), 0.6 in the first topology repair round (see buildEnvelope in
-/// Envelope.cxx). Merged polygons stay allowed where phi is smaller: the Gaussian of the
+/// unamplified one or less; the first topology repair round keeps it and merges at adaptivity 1,
+/// see buildEnvelope in Envelope.cxx). Merged polygons stay allowed where phi is smaller: the Gaussian of the
 /// amplification reaches far (phi - 1 is still 1% of alpha - 1 at 0.27 from an active point at
 /// beta 8), and with the first bound, phi > 1 + 0.01 (alpha - 1), nothing was left to merge on
 /// inputs with active points all over. Measured, 500-vertex cages (whole runs, `sdfcage --check`

@@ -140,7 +140,7 @@ INSTANTIATE_TEST_SUITE_P(Gaps, GapTopology,
   });
 
 // A repair round's finer grid merges polygons wherever its few amplified samples leave room
-// (adaptivity 1, uniform triangles only where phi > 1 + 0.6 (alpha - 1)): the hook whose tip is
+// (adaptivity 1, uniform triangles only where phi > 1 + 0.5 (alpha - 1)): the hook whose tip is
 // 0.015 from its straight part takes one round, and that round's merged envelope is the one kept.
 // It is verified like any other: the referee checks it encloses the input with the clearance, and
 // it keeps the input's topology. With adaptivity off everywhere the same round gives more
