@@ -230,6 +230,7 @@ CageResult generateOnce(const PreparedInput& prepared, const CageOptions& option
   result.IsosurfaceSeconds = env.IsosurfaceSeconds;
   result.VerificationSeconds = env.VerificationSeconds;
   result.VoxelSizeUsed = env.VoxelSizeUsed;
+  result.AdaptivityUsed = env.AdaptivityUsed;
   result.RemovedPockets = env.RemovedPockets;
   result.InputGenus = env.InputGenus;
   result.InputComponents = env.InputComponents;

@@ -93,6 +93,8 @@ struct CageResult
   int EnvelopeGenus = 0;
   int EnvelopeComponents = 0;
   double VoxelSizeUsed = 0.0; ///< unit-sphere units
+  /// adaptivity of the kept envelope's extraction (a topology repair round's 1, a failed one's fallback)
+  double AdaptivityUsed = 0.0;
   int InputGenus = 0;         ///< -1 where undefined (the input is not closed)
   int InputComponents = 0;
   bool InputClosed = false;                ///< closed, consistently oriented 2-manifold (after repair)

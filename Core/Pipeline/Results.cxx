@@ -156,6 +156,8 @@ ResultTable cageResults(const CageResult& r)
     integer("EnvelopeGenus", r.EnvelopeGenus, "", "genus of the envelope"),
     integer("EnvelopeComponents", r.EnvelopeComponents, "count", "connected parts of the envelope"),
     real("VoxelSizeUsed", r.VoxelSizeUsed, "relative", "voxel size of the distance grid, after any refinement"),
+    real("AdaptivityUsed", r.AdaptivityUsed, "",
+      "isosurface adaptivity of the kept envelope (1 from a topology repair round, lower after a failed extraction)"),
     flag("InputWasFlipped", d.FlippedOrientation, "the input was inward-oriented and was flipped"),
     integer("NumberOfActivePoints", static_cast<long long>(r.NumberOfActivePoints), "count",
       "input points found active (nearly touching another part)"),

@@ -284,7 +284,15 @@ void printSummary(std::ostream& os, const RunReport& r)
   }
   os << "\n";
   os << "voxel size  : " << number(r.number("VoxelSizeUsed")) << " (relative: the input scaled into the "
-     << "unit sphere), isovalue " << number(r.IsoValue) << ", adaptivity " << number(r.Adaptivity) << "\n";
+     << "unit sphere), isovalue " << number(r.IsoValue) << ", adaptivity " << number(r.Adaptivity);
+  // the kept envelope's, where it differs (a topology repair round merges at 1; a failed
+  // adaptive extraction falls back to 0.3, then 0)
+  if (sdfcage::findResult(r.Results, "AdaptivityUsed") && r.number("VoxelSizeUsed") > 0 &&
+    std::abs(r.number("AdaptivityUsed") - r.Adaptivity) > 1e-12)
+  {
+    os << " (the kept envelope's: " << number(r.number("AdaptivityUsed")) << ")";
+  }
+  os << "\n";
   if (r.integer("EnvelopeProbes") > 0)
   {
     os << "probes      : " << r.integer("EnvelopeProbes") << " coarse-grid probe(s) chose the isovalue in "

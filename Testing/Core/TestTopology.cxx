@@ -12,6 +12,7 @@
 #include "Envelope/ActivePoints.h"
 #include "Envelope/Envelope.h"
 #include "Pipeline/CageGenerator.h"
+#include "Pipeline/Results.h"
 
 #include <gtest/gtest.h>
 
@@ -170,6 +171,16 @@ TEST(TopologyRepair, FirstRoundMergesPolygonsAwayFromTheGap)
   EXPECT_EQ(uniform.TopologyRepairs, 1) << uniform.TopologyRepairLog;
   EXPECT_EQ(uniform.Genus, 0);
   EXPECT_LT(2 * merged.Envelope.Triangles.size(), uniform.Envelope.Triangles.size());
+
+  // the run reports the kept envelope's adaptivity (the CLI summary and the field data show it)
+  const CageResult cage = generateCage(PolygonMesh::fromTriangles(world), CageOptions());
+  ASSERT_EQ(cage.State, Status::Ok) << cage.Message;
+  EXPECT_EQ(cage.TopologyRepairs, 1);
+  EXPECT_DOUBLE_EQ(cage.AdaptivityUsed, 1.0);
+  const ResultTable table = cageResults(cage);
+  const ResultField* used = findResult(table, "AdaptivityUsed");
+  ASSERT_NE(used, nullptr);
+  EXPECT_DOUBLE_EQ(used->number(), 1.0);
 }
 
 // The strict option: with the repair off, a hook whose tip is 0.004 from its own straight part
