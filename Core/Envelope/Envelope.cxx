@@ -642,7 +642,19 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
       return result;
     }
     progressStage(progress, "active points", 0.02, 0.12 * progressEnd);
-    active = computeActivePoints(unitInput, options.ActivePoints, progress);
+    // The envelope at an active point lies at about c / alpha from the input: an alpha that
+    // puts it within the clearance (a clearance above c / (1.15 alpha): 0.0029 at the default
+    // c and alpha) fails verification on every grid (the built-in shape at clearance 0.0035:
+    // 8 ever finer grids, 63 s, 2.1 GB, then no cage). Such an alpha is lowered to keep the
+    // envelope 15% beyond the clearance, as the topology repair rounds do, and reported.
+    ActivePointOptions activeOptions = options.ActivePoints;
+    const double alphaRoom = std::max(1.0, options.IsoValue / (1.15 * options.clearance()));
+    if (activeOptions.Alpha > alphaRoom)
+    {
+      activeOptions.Alpha = alphaRoom;
+    }
+    result.AlphaUsed = activeOptions.Alpha;
+    active = computeActivePoints(unitInput, activeOptions, progress);
     result.ActivePointSeconds = active.Seconds;
     if (active.Cancelled || progressCancelled(progress))
     {
@@ -1247,7 +1259,10 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
     const double delta = round == 2 && automaticClearance ? 0.4 * delta0 : delta0;
     o.MinimumClearance = delta;
     // the envelope at an active point lies at about c / alpha: keep it 15% beyond the clearance
-    o.ActivePoints.Alpha = std::max(options.ActivePoints.Alpha, c / (1.15 * delta));
+    // (a larger requested alpha would put it within the clearance: buildEnvelopeOnce lowers
+    // any alpha to this bound, so the log states the one used)
+    o.ActivePoints.Alpha =
+      std::min(std::max(options.ActivePoints.Alpha, c / (1.15 * delta)), std::max(1.0, c / (1.15 * delta)));
     // The first round's finer grid, with merged polygons wherever the amplification leaves room:
     // OpenVDB merges any unambiguous, manifold block at adaptivity 1 (no normal test), and the
     // samples the round amplifies keep uniform triangles where phi > 1 + 0.5 (alpha - 1) (the

@@ -161,6 +161,10 @@ struct EnvelopeResult
   int AdaptiveRepairs = 0;           ///< re-extractions with adaptivity switched off around defects
   std::size_t LiftedPoints = 0;      ///< points added where adaptive polygons cut corners (LiftCutCorners)
   double AdaptivityUsed = 0.0;       ///< adaptivity of the accepted envelope
+  /// The amplification's alpha the accepted envelope used (0 without active points): the
+  /// requested one, or lowered to c / (1.15 delta) where that one would put the envelope at the
+  /// active points within the clearance delta.
+  double AlphaUsed = 0.0;
   double DistanceFieldSeconds = 0.0;
   double IsosurfaceSeconds = 0.0;
   double VerificationSeconds = 0.0;

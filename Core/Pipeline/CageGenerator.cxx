@@ -231,6 +231,7 @@ CageResult generateOnce(const PreparedInput& prepared, const CageOptions& option
   result.VerificationSeconds = env.VerificationSeconds;
   result.VoxelSizeUsed = env.VoxelSizeUsed;
   result.AdaptivityUsed = env.AdaptivityUsed;
+  result.AlphaUsed = env.AlphaUsed;
   result.RemovedPockets = env.RemovedPockets;
   result.InputGenus = env.InputGenus;
   result.InputComponents = env.InputComponents;

@@ -95,6 +95,10 @@ struct CageResult
   double VoxelSizeUsed = 0.0; ///< unit-sphere units
   /// adaptivity of the kept envelope's extraction (a topology repair round's 1, a failed one's fallback)
   double AdaptivityUsed = 0.0;
+  /// the amplification's alpha of the kept envelope (0 without active points): the requested one,
+  /// or lowered to IsoValue / (1.15 clearance) where that one would put the envelope within the
+  /// clearance at the active points (EnvelopeResult::AlphaUsed)
+  double AlphaUsed = 0.0;
   int InputGenus = 0;         ///< -1 where undefined (the input is not closed)
   int InputComponents = 0;
   bool InputClosed = false;                ///< closed, consistently oriented 2-manifold (after repair)

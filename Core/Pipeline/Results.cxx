@@ -156,6 +156,9 @@ ResultTable cageResults(const CageResult& r)
     integer("EnvelopeGenus", r.EnvelopeGenus, "", "genus of the envelope"),
     integer("EnvelopeComponents", r.EnvelopeComponents, "count", "connected parts of the envelope"),
     real("VoxelSizeUsed", r.VoxelSizeUsed, "relative", "voxel size of the distance grid, after any refinement"),
+    real("AmplificationAlphaUsed", r.AlphaUsed, "",
+      "amplification alpha of the kept envelope (0 without active points; lowered where the requested one "
+      "would put the envelope within the clearance)"),
     real("AdaptivityUsed", r.AdaptivityUsed, "",
       "isosurface adaptivity of the kept envelope (1 from a topology repair round, lower after a failed extraction)"),
     flag("InputWasFlipped", d.FlippedOrientation, "the input was inward-oriented and was flipped"),

@@ -248,8 +248,16 @@ void printSummary(std::ostream& os, const RunReport& r)
   else if (r.UseActivePoints)
   {
     os << "active pts  : " << r.integer("NumberOfActivePoints") << " input points (r " << number(r.ActiveRadius)
-       << ", l " << number(r.GeodesicThreshold) << ", alpha " << number(r.AmplificationAlpha) << ", beta "
-       << number(r.AmplificationBeta) << "), " << seconds(r.number("ActivePointTime")) << "\n";
+       << ", l " << number(r.GeodesicThreshold) << ", alpha " << number(r.AmplificationAlpha);
+    // lowered where the requested alpha would put the envelope within the clearance (or raised by
+    // a topology repair round): the kept envelope's
+    const double alphaUsed =
+      sdfcage::findResult(r.Results, "AmplificationAlphaUsed") ? r.number("AmplificationAlphaUsed") : 0.0;
+    if (alphaUsed > 0 && std::abs(alphaUsed - r.AmplificationAlpha) > 1e-9)
+    {
+      os << " (the kept envelope's: " << number(alphaUsed) << ")";
+    }
+    os << ", beta " << number(r.AmplificationBeta) << "), " << seconds(r.number("ActivePointTime")) << "\n";
   }
   else
   {
