@@ -328,8 +328,10 @@ public:
    * envelope lies closer to the input there (down to IsoValue / AmplificationAlpha) and keeps
    * the parts separate. Off: the plain offset {SDF = IsoValue}, which may fuse them. Lengths are
    * relative to the input scaled into the unit sphere (defaults r 0.025, l 0.15, alpha 3,
-   * beta 8). If the envelope still does not have the input's genus and component count, a
-   * warning says so (GetTopologyWarning()).
+   * beta 8). An AmplificationAlpha above IsoValue / (1.15 clearance) would put the envelope
+   * within the clearance at the active points: it is lowered to that bound for the run (result
+   * AmplificationAlphaUsed). If the envelope still does not have the input's genus and component
+   * count, a warning says so (GetTopologyWarning()).
    */
   vtkSetMacro(UseActivePoints, vtkTypeBool);
   vtkGetMacro(UseActivePoints, vtkTypeBool);
