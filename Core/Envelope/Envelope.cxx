@@ -516,6 +516,13 @@ int minimumCageVertices(int components, int genus)
 namespace
 {
 
+/// The largest alpha that keeps the envelope at an active point (about isoValue / alpha from
+/// the input) 15% beyond the clearance; at least 1 (no amplification).
+double alphaKeepingClearance(double isoValue, double clearance)
+{
+  return std::max(1.0, isoValue / (1.15 * clearance));
+}
+
 /// One envelope with the given options (no topology repair).
 EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOptions& options, Progress* progress,
   double progressEnd, int inputClosed)
@@ -648,11 +655,7 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
     // 8 ever finer grids, 63 s, 2.1 GB, then no cage). Such an alpha is lowered to keep the
     // envelope 15% beyond the clearance, as the topology repair rounds do, and reported.
     ActivePointOptions activeOptions = options.ActivePoints;
-    const double alphaRoom = std::max(1.0, options.IsoValue / (1.15 * options.clearance()));
-    if (activeOptions.Alpha > alphaRoom)
-    {
-      activeOptions.Alpha = alphaRoom;
-    }
+    activeOptions.Alpha = std::min(activeOptions.Alpha, alphaKeepingClearance(options.IsoValue, options.clearance()));
     result.AlphaUsed = activeOptions.Alpha;
     active = computeActivePoints(unitInput, activeOptions, progress);
     result.ActivePointSeconds = active.Seconds;
@@ -1259,10 +1262,8 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
     const double delta = round == 2 && automaticClearance ? 0.4 * delta0 : delta0;
     o.MinimumClearance = delta;
     // the envelope at an active point lies at about c / alpha: keep it 15% beyond the clearance
-    // (a larger requested alpha would put it within the clearance: buildEnvelopeOnce lowers
-    // any alpha to this bound, so the log states the one used)
-    o.ActivePoints.Alpha =
-      std::min(std::max(options.ActivePoints.Alpha, c / (1.15 * delta)), std::max(1.0, c / (1.15 * delta)));
+    // (the strongest amplification that does: buildEnvelopeOnce would lower a larger one to it)
+    o.ActivePoints.Alpha = alphaKeepingClearance(c, delta);
     // The first round's finer grid, with merged polygons wherever the amplification leaves room:
     // OpenVDB merges any unambiguous, manifold block at adaptivity 1 (no normal test), and the
     // samples the round amplifies keep uniform triangles where phi > 1 + 0.5 (alpha - 1) (the
