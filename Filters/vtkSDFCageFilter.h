@@ -184,7 +184,9 @@ public:
   ///@{
   /**
    * Clearance delta that every envelope triangle must keep from every input triangle, relative
-   * to the input scaled into the unit sphere. 0 (the default) chooses IsoValue / 4.
+   * to the input scaled into the unit sphere. 0 (the default) chooses IsoValue / 4. It must be
+   * at most IsoValue / 1.15 (the envelope lies about IsoValue from the input and needs 15% room
+   * to be verified): a larger one fails at once with the values that work in the error.
    */
   vtkSetClampMacro(MinimumClearance, double, 0.0, 0.5);
   vtkGetMacro(MinimumClearance, double);

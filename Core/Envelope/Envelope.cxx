@@ -516,11 +516,25 @@ int minimumCageVertices(int components, int genus)
 namespace
 {
 
+/// The room the envelope keeps beyond the clearance: 15% (at the isovalue, and at an active
+/// point with the amplification lowered to alphaKeepingClearance).
+constexpr double ClearanceRoom = 1.15;
+
+/// The weakest amplification a topology repair round is tried with.
+constexpr double MinimumRepairAlpha = 1.5;
+
+/// x > 0 rounded up or down to three significant digits (advice that holds as printed).
+double roundToDigits(double x, bool up)
+{
+  const double unit = std::pow(10.0, std::floor(std::log10(x)) - 2);
+  return (up ? std::ceil(x / unit * (1 - 1e-12)) : std::floor(x / unit * (1 + 1e-12))) * unit;
+}
+
 /// The largest alpha that keeps the envelope at an active point (about isoValue / alpha from
 /// the input) 15% beyond the clearance; at least 1 (no amplification).
 double alphaKeepingClearance(double isoValue, double clearance)
 {
-  return std::max(1.0, isoValue / (1.15 * clearance));
+  return std::max(1.0, isoValue / (ClearanceRoom * clearance));
 }
 
 /// One envelope with the given options (no topology repair).
@@ -542,6 +556,22 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
   {
     result.State = Status::InvalidInput;
     result.Message = "invalid parameters: need IsoValue > 0, VoxelSize > 0 and 0 < MinimumClearance < IsoValue";
+    return result;
+  }
+  // The envelope lies at about c from the input (c / alpha at active points) and is verified
+  // to keep the clearance: a clearance within 15% of c leaves the isosurface's error no room
+  // on any affordable grid and no amplification at all (built-in shape, c 0.01: clearance
+  // 0.0095 ran more than 200 s through ever finer grids), so it is refused at once.
+  if (delta * ClearanceRoom > c)
+  {
+    std::ostringstream m;
+    m << "the minimum clearance " << delta << " is too close to the isovalue " << c
+      << " (unit-sphere units): the envelope lies about the isovalue from the input and needs at least "
+      << static_cast<int>(std::lround(100 * (ClearanceRoom - 1))) << "% more than the clearance to be verified; "
+      << "use an isovalue of at least " << roundToDigits(ClearanceRoom * delta, true) << " or a clearance of at most "
+      << roundToDigits(c / ClearanceRoom, false);
+    result.State = Status::InvalidInput;
+    result.Message = m.str();
     return result;
   }
   // The inside rule: flood fill for a closed, consistently oriented 2-manifold, the winding
@@ -1285,6 +1315,20 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
     const double voxels = area / (o.VoxelSize * o.VoxelSize);
     log << "; round " << round << ": voxel " << o.VoxelSize << ", alpha " << o.ActivePoints.Alpha << ", clearance "
         << delta;
+    // A clearance close to the isovalue leaves the round almost no amplification: it would
+    // separate only parts between 2c / alpha and 2c apart, at 4 and 16 times the first envelope's
+    // cost (built-in shape, clearance 0.86 c: alpha 1.01, rounds of 6.6 and 24.6 s, nothing
+    // separated).
+    if (o.ActivePoints.Alpha < MinimumRepairAlpha)
+    {
+      log << ": not tried (the clearance leaves room for an amplification of " << o.ActivePoints.Alpha
+          << " only, less than " << MinimumRepairAlpha << ": a larger IsoValue or a smaller clearance lets it amplify)";
+      if (automaticClearance && round == 1)
+      {
+        continue; // round 2 lowers an automatic clearance, which leaves more room
+      }
+      break;
+    }
     if (voxels > options.MaximumRepairSurfaceVoxels)
     {
       log << ": not tried (about " << static_cast<long long>(voxels) << " surface voxels, more than "

@@ -626,6 +626,37 @@ TEST(CageErrors, OpenInputIsCagedAndReported)
   EXPECT_EQ(result.VerticesReached, 60);
 }
 
+TEST(CageErrors, ClearanceTooCloseToTheIsoValueIsRefusedAtOnce)
+{
+  // The envelope lies about c from the input: a clearance within 15% of c cannot be verified
+  // on any affordable grid (it ran more than 200 s through ever finer grids before).
+  const TriangleMesh shape = makeBuiltinShape();
+  const TriangleMesh unit = Normalization::fit(shape).toUnit(shape);
+  EnvelopeOptions options;
+  options.IsoValue = 0.01;
+  options.MinimumClearance = 0.0095;
+  const EnvelopeResult r = buildEnvelope(unit, options);
+  EXPECT_EQ(r.State, Status::InvalidInput) << statusName(r.State);
+  EXPECT_TRUE(r.Envelope.empty());
+  // the advice holds as printed: 1.15 * 0.0095 = 0.010925 rounded up, 0.01 / 1.15 = 0.0086956
+  // rounded down
+  EXPECT_NE(r.Message.find("use an isovalue of at least 0.011 or a clearance of at most 0.00869"), std::string::npos)
+    << r.Message;
+
+  // just below the bound: a verified envelope, and no topology repair round at an amplification
+  // of 1.24 (it would separate only parts 2c / 1.24 to 2c apart, at 4 to 16 times the cost)
+  options.MinimumClearance = 0.007;
+  const EnvelopeResult near = buildEnvelope(unit, options);
+  ASSERT_EQ(near.State, Status::Ok) << near.Message;
+  EXPECT_TRUE(near.EnclosureVerified);
+  EXPECT_EQ(near.TopologyRepairs, 0) << near.TopologyRepairLog;
+  EXPECT_NE(near.TopologyRepairLog.find("round 1: voxel 0.0025, alpha 1.24224, clearance 0.007: not tried (the "
+                                        "clearance leaves room for an amplification of 1.24224 only"),
+    std::string::npos)
+    << near.TopologyRepairLog;
+  EXPECT_EQ(near.TopologyRepairLog.find("round 2"), std::string::npos) << "a fixed clearance: round 2 has no more room";
+}
+
 TEST(CageErrors, BrokenInputIsInvalid)
 {
   PolygonMesh nan = PolygonMesh::fromTriangles(makeBox(Vec3(0, 0, 0), Vec3(1, 1, 1)));
