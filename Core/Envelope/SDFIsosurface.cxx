@@ -507,9 +507,11 @@ TriangleMesh extract(const openvdb::FloatGrid::ConstPtr& grid, double iso, doubl
 }
 
 /// Marks the voxels within `radius` voxels of each point (unit-sphere units).
-void markAround(const std::vector<Vec3>& points, double voxelSize, int radius, openvdb::BoolTree& mask)
+/// Returns how many voxels were not marked before.
+std::size_t markAround(const std::vector<Vec3>& points, double voxelSize, int radius, openvdb::BoolTree& mask)
 {
   openvdb::tree::ValueAccessor<openvdb::BoolTree> acc(mask);
+  std::size_t added = 0;
   for (const Vec3& p : points)
   {
     const openvdb::Coord c(static_cast<int>(std::lround(p.x() / voxelSize)),
@@ -518,9 +520,15 @@ void markAround(const std::vector<Vec3>& points, double voxelSize, int radius, o
       for (int j = -radius; j <= radius; ++j)
         for (int i = -radius; i <= radius; ++i)
         {
-          acc.setValueOn(c.offsetBy(i, j, k), true);
+          const openvdb::Coord ijk = c.offsetBy(i, j, k);
+          if (!acc.isValueOn(ijk))
+          {
+            acc.setValueOn(ijk, true);
+            ++added;
+          }
         }
   }
+  return added;
 }
 
 } // namespace
@@ -1167,7 +1175,14 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
       {
         break;
       }
-      markAround(repairNear, voxelSize, 2, *noAdapt);
+      // Nothing newly marked: the next extraction would be this one again, and fail alike (the
+      // defect lies where the triangles are uniform already: the amplified offset itself within
+      // the clearance, not merged polygons). dragon_quartet with its repair rounds on grids where
+      // the amplification fails: four identical extractions and verifications per adaptivity.
+      if (markAround(repairNear, voxelSize, 2, *noAdapt) == 0)
+      {
+        break;
+      }
     }
     if (!out.Surfaces.empty() && judge)
     {
