@@ -3,6 +3,7 @@
 #include "Pipeline/CageGenerator.h"
 #include "CoreTestPrinters.h"
 #include "Envelope/Envelope.h"
+#include "Envelope/SDFIsosurface.h"
 #include "ExactCheck.h"
 #include "Spatial/Geometry.h"
 #include "Mesh/Mesh.h"
@@ -450,6 +451,37 @@ TEST(TopologyRepair, SelfCrossingInputRunsNoRound)
   ASSERT_EQ(plain.State, Status::Ok) << plain.Message;
   EXPECT_EQ(plain.Genus, 0);
   EXPECT_TRUE(plain.SelfFusedSites.empty());
+}
+
+TEST(AdaptiveRepair, StopsWhenItWouldExtractTheSameSurfaceAgain)
+{
+  // A judge that rejects every surface and points at the same place each time: the first repair
+  // makes the triangles there uniform; a second would change nothing (the same extraction, the
+  // same verdict), so the tries at that adaptivity end (before: 1 + maxRepairs identical ones).
+  const TriangleMesh sphere = makeSphere(Vec3(0, 0, 0), 0.8, 48, 24);
+  int adaptive = 0, uniform = 0;
+  const SurfaceJudge stuck = [&](const TriangleMesh&, double adaptivity, std::vector<Vec3>& near) {
+    ++(adaptivity > 0.0 ? adaptive : uniform);
+    near = { Vec3(0.84, 0.0, 0.0) };
+    return false;
+  };
+  const IsosurfaceOutput out = computeIsosurface(sphere, 0.02, 0.04, false, nullptr, { 0.3, 0.0 }, nullptr, &stuck, 4);
+  EXPECT_TRUE(out.Error.empty()) << out.Error;
+  EXPECT_TRUE(out.Surfaces.empty());
+  EXPECT_EQ(adaptive, 2) << "the first extraction and one repair";
+  EXPECT_EQ(uniform, 1);
+  // defects that move (new voxels each time) keep the repairs going, up to maxRepairs
+  int moving = 0;
+  const SurfaceJudge wandering = [&](const TriangleMesh&, double adaptivity, std::vector<Vec3>& near) {
+    if (adaptivity > 0.0)
+    {
+      near = { Vec3(0.84 * std::cos(0.3 * moving), 0.84 * std::sin(0.3 * moving), 0.0) }; // 12 voxels apart
+      ++moving;
+    }
+    return false;
+  };
+  computeIsosurface(sphere, 0.02, 0.04, false, nullptr, { 0.3, 0.0 }, nullptr, &wandering, 4);
+  EXPECT_EQ(moving, 5) << "the first extraction and maxRepairs = 4 repairs";
 }
 
 TEST(Envelope, LargerIsoValueExplicitAndExactClearance)
