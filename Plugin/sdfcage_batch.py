@@ -369,6 +369,9 @@ def write_collection(rows, out):
         # this writer is collective under MPI; here rank 0 alone writes the whole collection
         from vtkmodules.vtkParallelCore import vtkDummyController
         writer.SetController(vtkDummyController())
+    # inline arrays, not appended ones: VTK 9.1 cannot read appended data back with the expat of
+    # an up-to-date Debian 12 (Examples/CLI/CLIVTP.cxx)
+    writer.SetDataModeToBinary()
     writer.SetInputData(collection)
     writer.SetFileName(os.path.join(out, "cages.vtpc"))
     writer.Write()

@@ -292,6 +292,7 @@ vtkSmartPointer<vtkPolyData> readMesh(
       error = "cannot read '" + path + "': not a VTK XML PolyData (.vtp) file";
       return nullptr;
     }
+    std::string inlined;
     {
       std::string bytes;
       std::string why;
@@ -305,8 +306,23 @@ vtkSmartPointer<vtkPolyData> readMesh(
         error = "cannot read '" + path + "': " + why;
         return nullptr;
       }
+      // appended data moved inline: VTK 9.1 cannot read it with an up-to-date Debian 12's
+      // expat (CLIVTP.cxx)
+      if (bytes.find("<AppendedData") != std::string::npos && !sdfcage_cli::inlineAppendedXML(bytes, inlined, why))
+      {
+        error = "cannot read '" + path + "': " + why;
+        return nullptr;
+      }
     }
-    reader->SetFileName(path.c_str());
+    if (inlined.empty())
+    {
+      reader->SetFileName(path.c_str());
+    }
+    else
+    {
+      reader->ReadFromInputStringOn();
+      reader->SetInputString(inlined);
+    }
     // Only the points and cells make the cage: the point and cell data arrays are not read.
     // Their sizes are not checked by the reader before it allocates (a PointData array declaring
     // 1e9 components on 4 points allocated 8 GB and ran for minutes).
@@ -428,6 +444,9 @@ bool writeMesh(vtkPolyData* mesh, const std::string& path, std::string& error)
   else if (ext == ".vtp")
   {
     vtkNew<vtkXMLPolyDataWriter> writer;
+    // inline, not appended: VTK 9.1 cannot read appended data with an up-to-date Debian 12's
+    // expat (CLIVTP.cxx)
+    writer->SetDataModeToBinary();
     writer->SetFileName(path.c_str());
     writer->SetInputData(mesh);
     ok = writer->Write();

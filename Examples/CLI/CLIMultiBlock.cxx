@@ -50,6 +50,7 @@ bool writeMultiBlock(vtkMultiBlockDataSet* levels, const std::string& path, std:
   if (lowerExtension(path) == ".vtm")
   {
     vtkNew<vtkXMLMultiBlockDataWriter> writer;
+    writer->SetDataModeToBinary(); // inline arrays: see CLIVTP.cxx
     writer->SetFileName(path.c_str());
     writer->SetInputData(levels);
     ok = writer->Write();
@@ -75,6 +76,7 @@ bool writeMultiBlock(vtkMultiBlockDataSet* levels, const std::string& path, std:
       }
     }
     vtkNew<vtkXMLPartitionedDataSetCollectionWriter> writer;
+    writer->SetDataModeToBinary(); // inline arrays: see CLIVTP.cxx
     writer->SetFileName(path.c_str());
     writer->SetInputData(collection);
     ok = writer->Write();

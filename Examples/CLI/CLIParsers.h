@@ -65,6 +65,14 @@ bool parseSTL(const char* data, std::size_t size, ParsedMesh& mesh, std::string&
 bool parseLegacyVTK(const char* data, std::size_t size, ParsedMesh& mesh, std::string& error,
   const std::function<bool()>& cancelled = {});
 
+/// A VTK XML file (held in memory) with its appended data section moved inline: each array in
+/// "appended" format becomes the same array in "binary" format, and the <AppendedData> section
+/// is dropped. A file without appended data is copied as it is. False with a one-line reason when
+/// an offset, a header or a size does not fit the appended section. Why: VTK 9.1's XML readers
+/// cannot read appended data with the expat of an up-to-date Debian 12 (CLIVTP.cxx says more).
+/// The implementation uses VTK's base64 encoder.
+bool inlineAppendedXML(const std::string& in, std::string& out, std::string& error);
+
 /// The parsers' tokenizer: the next white-space separated word of [p, end) into `out` (at most
 /// 257 characters: longer ones come in pieces, which no keyword or number matches), lower-cased
 /// when `lower`; `p` is left after it. False at the end.

@@ -152,6 +152,27 @@ def vtp_tetrahedron(point_components=3, data_components=1):
             b'</PolyData></VTKFile>\n') % (data_components, point_components)
 
 
+def vtp_tetrahedron_appended(offset_lie=None, size_lie=None):
+    """A tetrahedron as VTK XML PolyData with raw appended arrays (what VTK's and ParaView's
+    writers write by default, and what VTK 9.1 cannot read back with an up-to-date Debian 12's
+    expat: the CLI moves the arrays inline first); the third array's offset or the first array's
+    byte count can lie."""
+    arrays = [struct.pack("<12f", 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1),
+              struct.pack("<12i", 0, 2, 1, 0, 1, 3, 0, 3, 2, 1, 2, 3),
+              struct.pack("<4i", 3, 6, 9, 12)]
+    blobs = [struct.pack("<I", len(a) if (i or size_lie is None) else size_lie) + a for i, a in enumerate(arrays)]
+    offsets = [0, len(blobs[0]), len(blobs[0]) + len(blobs[1])]
+    if offset_lie is not None:
+        offsets[2] = offset_lie
+    return (b'<?xml version="1.0"?>\n<VTKFile type="PolyData" version="0.1" byte_order="LittleEndian">'
+            b'<PolyData><Piece NumberOfPoints="4" NumberOfPolys="4"><Points>'
+            b'<DataArray type="Float32" NumberOfComponents="3" format="appended" offset="%d"/></Points><Polys>'
+            b'<DataArray type="Int32" Name="connectivity" format="appended" offset="%d"/>'
+            b'<DataArray type="Int32" Name="offsets" format="appended" offset="%d"/></Polys></Piece>'
+            b'</PolyData><AppendedData encoding="raw">\n_' % tuple(offsets)
+            + b"".join(blobs) + b'\n</AppendedData></VTKFile>\n')
+
+
 def random_bytes(n, seed):
     rng = random.Random(seed)
     return bytes(rng.randrange(256) for _ in range(n))
@@ -244,6 +265,12 @@ CASES = {
                              "declares 1000000000 components", {}),
     "vtp_data_components": ("m.vtp", vtp_tetrahedron(data_components=1000000000), ["-n", "20"], 0, None,
                             {"check": True}),
+    # appended raw data (VTK's default): moved inline and caged; offsets and sizes that lie: refused
+    "vtp_appended": ("m.vtp", vtp_tetrahedron_appended(), ["-n", "20"], 0, None, {"check": True}),
+    "vtp_appended_offset_lies": ("m.vtp", vtp_tetrahedron_appended(offset_lie=10 ** 12), [], 2,
+                                 "beyond the appended data", {}),
+    "vtp_appended_size_lies": ("m.vtp", vtp_tetrahedron_appended(size_lie=2 ** 31), [], 2,
+                               "size runs past the appended data", {}),
     # a version-5 legacy file whose offsets point outside the connectivity
     "offsets_damaged_vtk5": ("m.vtk", vtk5_text(CUBE_POINTS, CUBE_TRIANGLES, bad_offset=900), [], 2,
                              "the file is damaged", {}),
