@@ -261,7 +261,8 @@ bool inlineAppendedXML(const std::string& in, std::string& out, std::string& err
     {
       for (std::size_t b = 3; b < headerWords; ++b)
       {
-        size += readWord(begin + b * word);
+        const unsigned long long blockSize = readWord(begin + b * word);
+        size += std::min<unsigned long long>(blockSize, dataEnd - begin + 1); // no wrap-around
         if (size > dataEnd - begin)
         {
           break;
