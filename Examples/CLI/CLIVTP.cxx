@@ -35,18 +35,22 @@ namespace sdfcage_cli
 namespace
 {
 
+bool isSpace(char c)
+{
+  return c == ' ' || c == '\t' || c == '\r' || c == '\n';
+}
+
 /// The value of the attribute `name` in the tag text [begin, end) of `s`, or false. Only the tag
 /// is searched, so that the work stays linear in the file.
 bool attribute(const std::string& s, std::size_t begin, std::size_t end, const char* name, std::string& value,
   std::size_t* position = nullptr)
 {
-  auto space = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; };
   const std::string tag = s.substr(begin, end - begin);
   const std::string key = std::string(name) + "=";
   for (std::size_t a = tag.find(key); a != std::string::npos; a = tag.find(key, a + 1))
   {
     std::size_t v = a + key.size();
-    if (a == 0 || !space(tag[a - 1]) || v >= tag.size() || (tag[v] != '"' && tag[v] != '\''))
+    if (a == 0 || !isSpace(tag[a - 1]) || v >= tag.size() || (tag[v] != '"' && tag[v] != '\''))
     {
       continue;
     }
@@ -137,7 +141,7 @@ bool inlineAppendedXML(const std::string& in, std::string& out, std::string& err
   std::size_t dataEnd = sectionEnd;
   if (encoding == "base64")
   {
-    while (dataEnd > dataBegin && std::strchr(" \t\r\n", in[dataEnd - 1]))
+    while (dataEnd > dataBegin && isSpace(in[dataEnd - 1]))
     {
       --dataEnd;
     }
@@ -171,11 +175,10 @@ bool inlineAppendedXML(const std::string& in, std::string& out, std::string& err
   // every appended array in the XML part
   std::vector<Array> arrays;
   // (<DataArray> in point, cell and piece data; <Array> in field data)
-  auto space = [](char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\n'; };
   for (std::size_t p = in.find('<', fileTagEnd); p < section; p = in.find('<', p + 1))
   {
-    const bool dataArray = in.compare(p + 1, 9, "DataArray") == 0 && p + 10 < in.size() && space(in[p + 10]);
-    if (!dataArray && !(in.compare(p + 1, 5, "Array") == 0 && p + 6 < in.size() && space(in[p + 6])))
+    const bool dataArray = in.compare(p + 1, 9, "DataArray") == 0 && p + 10 < in.size() && isSpace(in[p + 10]);
+    if (!dataArray && !(in.compare(p + 1, 5, "Array") == 0 && p + 6 < in.size() && isSpace(in[p + 6])))
     {
       continue;
     }
@@ -200,7 +203,14 @@ bool inlineAppendedXML(const std::string& in, std::string& out, std::string& err
     arrays.push_back(a);
   }
 
-  // the inline text of each array
+  // the inline text of each array: base64 text is [Begin, Begin + Length) of the input, raw
+  // arrays are encoded into Encoded
+  struct Inline
+  {
+    std::size_t Begin = 0;
+    std::size_t Length = 0;
+    std::string Encoded;
+  };
   std::vector<std::size_t> starts;
   starts.reserve(arrays.size());
   for (const Array& a : arrays)
@@ -209,7 +219,7 @@ bool inlineAppendedXML(const std::string& in, std::string& out, std::string& err
   }
   std::sort(starts.begin(), starts.end());
   starts.erase(std::unique(starts.begin(), starts.end()), starts.end());
-  std::map<std::size_t, std::string> text;
+  std::map<std::size_t, Inline> text;
   const unsigned char* bytes = reinterpret_cast<const unsigned char*>(in.data());
   auto readWord = [&](std::size_t at) {
     unsigned long long v = 0;
@@ -226,7 +236,7 @@ bool inlineAppendedXML(const std::string& in, std::string& out, std::string& err
     const std::size_t limit = i + 1 < starts.size() ? dataBegin + starts[i + 1] : dataEnd;
     if (encoding == "base64")
     {
-      text[starts[i]] = in.substr(begin, limit - begin);
+      text[starts[i]] = Inline{ begin, limit - begin, {} };
       continue;
     }
     // raw: the header's words, then the bytes they count
@@ -276,7 +286,7 @@ bool inlineAppendedXML(const std::string& in, std::string& out, std::string& err
     }
     // inline, an uncompressed array is one base64 stream of its header and bytes; a compressed
     // one is its header's stream, then its blocks' stream
-    text[starts[i]] = compressed
+    text[starts[i]].Encoded = compressed
       ? base64(bytes + begin, headerBytes) + base64(bytes + begin + headerBytes, static_cast<std::size_t>(size))
       : base64(bytes + begin, headerBytes + static_cast<std::size_t>(size));
   }
@@ -311,7 +321,15 @@ bool inlineAppendedXML(const std::string& in, std::string& out, std::string& err
     out.append(in, copied, a.TagBegin - copied);
     out += tag;
     out += '\n';
-    out += text[a.Offset];
+    const Inline& t = text[a.Offset];
+    if (t.Encoded.empty())
+    {
+      out.append(in, t.Begin, t.Length);
+    }
+    else
+    {
+      out += t.Encoded;
+    }
     out += '\n';
     if (a.SelfClosing)
     {
