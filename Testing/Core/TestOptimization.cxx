@@ -343,8 +343,8 @@ struct UnitRandom
 
 TEST(Optimization, TreeTriangleQueriesMatchBruteForce)
 {
-  // the tree's pruning (bounding boxes, the query's plane and side planes) must not change the
-  // answers: distances, "any closer" and "all within" against a brute-force loop
+  // the tree's pruning (bounding boxes, the query's and each input triangle's plane and side
+  // planes) must not change the answers: distances, "any closer" and "all within" against a brute-force loop
   const TriangleMesh mesh = makeTorus(Vec3(0, 0, 0), 1.0, 0.3, 48, 16);
   const TriangleTree tree(mesh);
   UnitRandom uniform{ 12345u };
