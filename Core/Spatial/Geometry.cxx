@@ -163,6 +163,39 @@ double triangleTriangleDistance2(const Vec3 a[3], const Vec3 b[3])
   return best;
 }
 
+bool trianglesCloserThan(const Vec3 a[3], const Vec3 b[3], double delta)
+{
+  // the parts of the distance in triangleTriangleDistance2's terms, each compared as the whole
+  // would be (sqrt(min) < delta exactly when some part's sqrt is), the cheapest first
+  for (int i = 0; i < 3; ++i)
+  {
+    if (std::sqrt((a[i] - closestPointOnTriangle(a[i], b[0], b[1], b[2])).squaredNorm()) < delta ||
+      std::sqrt((b[i] - closestPointOnTriangle(b[i], a[0], a[1], a[2])).squaredNorm()) < delta)
+    {
+      return true;
+    }
+  }
+  for (int i = 0; i < 3; ++i)
+  {
+    for (int j = 0; j < 3; ++j)
+    {
+      if (std::sqrt(segmentSegmentDistance2(a[i], a[(i + 1) % 3], b[j], b[(j + 1) % 3])) < delta)
+      {
+        return true;
+      }
+    }
+  }
+  for (int i = 0; i < 3; ++i)
+  {
+    if (segmentTriangleIntersect(a[i], a[(i + 1) % 3], b[0], b[1], b[2]) ||
+      segmentTriangleIntersect(b[i], b[(i + 1) % 3], a[0], a[1], a[2]))
+    {
+      return delta > 0.0;
+    }
+  }
+  return false;
+}
+
 namespace
 {
 // Is direction u inside the (closed) corner angle spanned by e1, e2 (normal n = e1 x e2)?

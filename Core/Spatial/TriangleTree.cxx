@@ -718,23 +718,28 @@ double TriangleTree::triangleQuery(const Vec3 t[3], double limit, bool stopAtFir
       {
         continue;
       }
-      const double d = std::sqrt(triangleTriangleDistance2(t, o.P));
       if (within)
       {
         // collect every triangle below the limit; the limit never shrinks
-        if (d < best)
+        if (trianglesCloserThan(t, o.P, best))
         {
           within->push_back(o.Id);
         }
         continue;
       }
+      if (stopAtFirst)
+      {
+        // only "closer than the limit?" is asked: answered without the exact distance
+        if (trianglesCloserThan(t, o.P, best))
+        {
+          return 0.0;
+        }
+        continue;
+      }
+      const double d = std::sqrt(triangleTriangleDistance2(t, o.P));
       if (d < best)
       {
         best = d;
-        if (stopAtFirst)
-        {
-          return best;
-        }
       }
     }
   }

@@ -100,6 +100,9 @@ private:
   // entries when no triangle is split.
   static double pieceLayout(const TriangleMesh& mesh, std::vector<std::size_t>& first);
   const Vec3* windingCorners(int entry) const { return Pieces.empty() ? Tri[entry].P : Pieces[entry].P; }
+  // The distance from t to the input if below `limit`, else `limit`; with stopAtFirst, a value
+  // below `limit` as soon as one triangle is closer than it (not the distance); with `within`,
+  // every triangle closer than `limit` is listed and `limit` returned.
   double triangleQuery(const Vec3 t[3], double limit, bool stopAtFirst, std::vector<int>* within = nullptr) const;
   struct Dipole
   {

@@ -420,3 +420,43 @@ TEST(TriangleIndex, TriangleDistanceMatchesBruteForce)
     }
   }
 }
+
+TEST(Geometry, CloserThanAgreesWithTheDistance)
+{
+  // trianglesCloserThan answers "sqrt(triangleTriangleDistance2) < delta" part by part with early
+  // exits: on crossing, touching, coplanar, edge-near and distant pairs it must give exactly the
+  // distance's answer, at deltas on both sides of it and at the distance itself.
+  std::mt19937 rng(29);
+  int closer = 0, crossing = 0, apart = 0;
+  for (int trial = 0; trial < 4000; ++trial)
+  {
+    Vec3 a[3], b[3];
+    for (int k = 0; k < 3; ++k)
+    {
+      a[k] = randomPoint(rng, -1.0, 1.0);
+      b[k] = randomPoint(rng, -1.0, 1.0) + Vec3(0.0, 0.0, trial % 4 == 0 ? 0.0 : 0.6 * (trial % 3));
+    }
+    if (trial % 5 == 0)
+    {
+      b[0] = a[1]; // touching at a corner
+    }
+    if (trial % 7 == 0)
+    {
+      for (Vec3& p : b)
+        p.z() = a[0].z() = a[1].z() = a[2].z() = 0.25; // coplanar
+    }
+    const double d = std::sqrt(triangleTriangleDistance2(a, b));
+    for (double delta : { 0.0, 1e-3, 0.05, 0.2, 0.5, 1.5, d, std::nextafter(d, 10.0), 0.5 * d })
+    {
+      const bool got = trianglesCloserThan(a, b, delta), want = d < delta;
+      EXPECT_EQ(got, want) << "trial " << trial << " distance " << d << " delta " << delta;
+      closer += got ? 1 : 0;
+    }
+    crossing += d == 0.0 ? 1 : 0;
+    apart += d > 0.2 ? 1 : 0;
+  }
+  // the pairs must exercise each case
+  EXPECT_GT(crossing, 200);
+  EXPECT_GT(apart, 200);
+  EXPECT_GT(closer, 4000);
+}
