@@ -537,9 +537,17 @@ double alphaKeepingClearance(double isoValue, double clearance)
   return std::max(1.0, isoValue / (ClearanceRoom * clearance));
 }
 
-/// One envelope with the given options (no topology repair).
+bool componentBoxesDisjoint(const TriangleMesh& m);
+
+/// One envelope with the given options (no topology repair). `skipWhenFused` (buildEnvelope's
+/// first envelope when a repair round may follow): an envelope on the requested grid whose genus
+/// exceeds the closed input's, or with fewer parts while the input's parts lie apart, is accepted
+/// as extracted, neither projected onto the amplified offset nor verified (VerificationDeferred):
+/// the repair round replaces it, and buildEnvelope builds it again the ordinary way should it be
+/// kept after all. dragon_quartet's first envelope failed its verification, was re-extracted and
+/// verified again before the round that replaced it.
 EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOptions& options, Progress* progress,
-  double progressEnd, int inputClosed)
+  double progressEnd, int inputClosed, bool skipWhenFused = false)
 {
   EnvelopeResult result;
   if (unitInput.empty())
@@ -829,6 +837,24 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
           result.Envelope = std::move(envelope);
           result.IsosurfaceSeconds += seconds(t0);
           return true; // stops the extraction; buildEnvelope reports TooComplex
+        }
+      }
+      if (skipWhenFused && !coarseLevel && flood && result.InputClosed && !options.DeferVerification)
+      {
+        topology();
+        if (usable &&
+          (g > result.InputGenus ||
+            (parts < result.InputComponents && parts >= 1 && componentBoxesDisjoint(unitInput))))
+        {
+          result.Envelope = std::move(envelope);
+          result.RemovedPockets = pockets;
+          result.VoxelSizeUsed = h;
+          result.AdaptivityUsed = adaptivity;
+          result.Refinements = std::max(0, level);
+          result.VerificationDeferred = true;
+          result.IsosurfaceSeconds += seconds(t0);
+          accepted = true;
+          return true; // stops the extraction
         }
       }
       if (adaptivity > 0.0 && options.LiftCutCorners && !(amplification && !amplification->empty()))
@@ -1220,11 +1246,28 @@ std::vector<Vec3> spreadSites(const std::vector<Vec3>& sites, std::size_t count,
 EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOptions& options, Progress* progress,
   double progressEnd, int inputClosed)
 {
-  EnvelopeResult first = buildEnvelopeOnce(unitInput, options, progress, progressEnd, inputClosed);
-  const bool repairable = first.SignUsed == SignMode::FloodFill && options.UseActivePoints &&
-    options.MaximumTopologyRepairs > 0 && !first.TooComplex;
+  const bool mayRepair = options.UseActivePoints && options.MaximumTopologyRepairs > 0;
+  EnvelopeResult first = buildEnvelopeOnce(unitInput, options, progress, progressEnd, inputClosed, mayRepair);
+  // The first envelope, when it was accepted unverified for a repair round (skipWhenFused) and
+  // is kept after all: built again the ordinary way (deterministic: the same envelope, verified,
+  // or re-extracted and refined as verification demands), the time spent on it counted.
+  const auto verifiedFirst = [&](EnvelopeResult& r) {
+    if (!r.VerificationDeferred || options.DeferVerification || r.State != Status::Ok)
+    {
+      return;
+    }
+    EnvelopeResult again = buildEnvelopeOnce(unitInput, options, progress, progressEnd, inputClosed);
+    again.DistanceFieldSeconds += r.DistanceFieldSeconds;
+    again.IsosurfaceSeconds += r.IsosurfaceSeconds;
+    again.VerificationSeconds += r.VerificationSeconds;
+    again.ActivePointSeconds += r.ActivePointSeconds;
+    again.GapSites = std::move(r.GapSites);
+    r = std::move(again);
+  };
+  const bool repairable = first.SignUsed == SignMode::FloodFill && mayRepair && !first.TooComplex;
   if (!repairable || !repairMayHelp(first, unitInput))
   {
+    verifiedFirst(first);
     if (topologyDiffers(first) && options.RequireTopology)
     {
       first.State = Status::TopologyChanged;
@@ -1246,6 +1289,11 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
     const int excess = std::max(0, first.Genus - first.InputGenus) + std::max(0, first.InputComponents - first.Components);
     if (!fused.empty() && excess <= static_cast<int>(fused.size()))
     {
+      verifiedFirst(first);
+      if (first.State != Status::Ok)
+      {
+        return first; // cancelled, or no grid verified it (as without the skip)
+      }
       std::ostringstream where;
       where << "the input intersects itself in " << fused.size()
             << " place(s) joining parts far apart along its surface, near (unit-sphere units):";
@@ -1384,6 +1432,16 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
       best.GapSites = r.GapSites;
     }
     addStageSeconds(best, r);
+  }
+  if (best.VerificationDeferred && !options.DeferVerification)
+  {
+    // no round was better: the first envelope is kept, verified now
+    verifiedFirst(best);
+    if (best.State == Status::Cancelled)
+    {
+      return best;
+    }
+    log << "; the first envelope kept";
   }
   best.TopologyRepairs = rounds;
   best.TopologyRepairLog = log.str();

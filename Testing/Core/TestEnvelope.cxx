@@ -687,6 +687,18 @@ TEST(CageErrors, ClearanceTooCloseToTheIsoValueIsRefusedAtOnce)
     std::string::npos)
     << near.TopologyRepairLog;
   EXPECT_EQ(near.TopologyRepairLog.find("round 2"), std::string::npos) << "a fixed clearance: round 2 has no more room";
+  // its fused first envelope was accepted unverified for the round, and is kept: built again the
+  // ordinary way, it is exactly the envelope made without repair rounds, verified
+  EXPECT_FALSE(near.VerificationDeferred);
+  EnvelopeOptions noRepairs = options;
+  noRepairs.MaximumTopologyRepairs = 0;
+  const EnvelopeResult plain = buildEnvelope(unit, noRepairs);
+  ASSERT_EQ(plain.State, Status::Ok) << plain.Message;
+  EXPECT_TRUE(near.Genus > near.InputGenus || near.Components < near.InputComponents)
+    << "the case must be a fused first envelope: genus " << near.Genus << ", parts " << near.Components;
+  EXPECT_EQ(near.Envelope.Points, plain.Envelope.Points);
+  EXPECT_EQ(near.Envelope.Triangles, plain.Envelope.Triangles);
+  EXPECT_EQ(near.MinimumClearance, plain.MinimumClearance);
 }
 
 TEST(CageErrors, BrokenInputIsInvalid)
