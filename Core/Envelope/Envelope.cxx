@@ -539,6 +539,13 @@ double alphaKeepingClearance(double isoValue, double clearance)
 
 bool componentBoxesDisjoint(const TriangleMesh& m);
 
+/// Did the envelope fuse what a repair round may separate? More handles than the closed input
+/// (fused parts closing a loop), or fewer parts while the input's parts lie apart.
+bool fusedApart(int genus, int parts, int inputGenus, int inputParts, const TriangleMesh& input)
+{
+  return genus > inputGenus || (parts < inputParts && parts >= 1 && componentBoxesDisjoint(input));
+}
+
 /// One envelope with the given options (no topology repair). `skipWhenFused` (buildEnvelope's
 /// first envelope when a repair round may follow): an envelope on the requested grid whose genus
 /// exceeds the closed input's, or with fewer parts while the input's parts lie apart, is accepted
@@ -842,9 +849,7 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
       if (skipWhenFused && !coarseLevel && flood && result.InputClosed && !options.DeferVerification)
       {
         topology();
-        if (usable &&
-          (g > result.InputGenus ||
-            (parts < result.InputComponents && parts >= 1 && componentBoxesDisjoint(unitInput))))
+        if (usable && fusedApart(g, parts, result.InputGenus, result.InputComponents, unitInput))
         {
           result.Envelope = std::move(envelope);
           result.RemovedPockets = pockets;
@@ -1045,8 +1050,7 @@ bool componentBoxesDisjoint(const TriangleMesh& m)
 /// loop), or fewer parts while the input's parts lie apart.
 bool repairMayHelp(const EnvelopeResult& r, const TriangleMesh& input)
 {
-  return topologyDiffers(r) &&
-    (r.Genus > r.InputGenus || (r.Components < r.InputComponents && componentBoxesDisjoint(input)));
+  return topologyDiffers(r) && fusedApart(r.Genus, r.Components, r.InputGenus, r.InputComponents, input);
 }
 
 /// Surface area of the input (unit-sphere units): the narrow-band grid holds about area / h^2

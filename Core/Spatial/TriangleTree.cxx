@@ -718,21 +718,17 @@ double TriangleTree::triangleQuery(const Vec3 t[3], double limit, bool stopAtFir
       {
         continue;
       }
-      if (within)
+      if (within || stopAtFirst)
       {
-        // collect every triangle below the limit; the limit never shrinks
+        // only "closer than the limit?" is asked (the limit never shrinks): answered without the
+        // exact distance; `within` collects every such triangle, stopAtFirst ends at the first
         if (trianglesCloserThan(t, o.P, best))
         {
+          if (!within)
+          {
+            return 0.0;
+          }
           within->push_back(o.Id);
-        }
-        continue;
-      }
-      if (stopAtFirst)
-      {
-        // only "closer than the limit?" is asked: answered without the exact distance
-        if (trianglesCloserThan(t, o.P, best))
-        {
-          return 0.0;
         }
         continue;
       }
