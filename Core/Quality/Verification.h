@@ -5,6 +5,7 @@
 
 #include "Mesh/Mesh.h"
 
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -31,5 +32,35 @@ long long countSelfIntersections(const TriangleMesh& mesh, Progress* progress = 
 bool verifyEnclosure(const TriangleMesh& input, const TriangleMesh& cage, double clearance, double& measuredClearance,
   std::string& why, std::vector<double>* pointDistances = nullptr, Progress* progress = nullptr,
   bool exactMinimum = true, const TriangleTree* inputTree = nullptr);
+
+/// What a verification learned about one surface, for the verification of the next surface
+/// when that one keeps most of its triangles: an adaptive envelope that failed is extracted again
+/// with adaptivity off around its defects only, and 90-96% of its triangles come back with the
+/// same corners (octopus-low, armadillo at the defaults). Create one per sequence of surfaces of
+/// the same input, clearance and grid.
+struct VerificationMemo
+{
+  /// Of the surface last checked, one flag per triangle: 1 where it conflicts with another
+  /// triangle (as countSelfIntersections counts) or comes closer than the clearance to the input.
+  /// Every triangle is judged: the check does not stop at the first failure.
+  std::vector<char> Defective;
+  /// Triangles that the next check takes from this memo instead of testing them.
+  std::size_t Reused = 0;
+  struct Store;
+  std::shared_ptr<Store> Known; ///< what the next surface may reuse (internal)
+};
+
+/// verifyEnclosure with `exactMinimum` false (the same answer, `why` and certified clearance), for
+/// a surface that shares triangles with the one `memo` last saw: a triangle whose three corners
+/// are the same points (the same doubles, the same orientation) as a sound triangle of that
+/// surface, and whose corners are not duplicated in this one, keeps what was found for it: no
+/// conflict with the other such triangles (they share corners exactly as before, so the pair's
+/// test is the same) and its certified distance to the input; point distances are reused by
+/// position. Every pair involving a new triangle, every new triangle's clearance, the 2-manifold
+/// test and the winding numbers are checked as usual. Fills memo.Defective and replaces what the
+/// memo keeps with this surface's findings.
+bool verifyEnclosureWithMemo(const TriangleMesh& input, const TriangleMesh& surface, double clearance,
+  double& measuredClearance, std::string& why, std::vector<double>* pointDistances, Progress* progress,
+  const TriangleTree& inputTree, VerificationMemo& memo);
 
 } // namespace sdfcage

@@ -10,6 +10,8 @@
 #include "Mesh/Normalization.h"
 #include "Common/Progress.h"
 #include "Mesh/Shapes.h"
+#include "Quality/Verification.h"
+#include "Spatial/TriangleTree.h"
 
 #include <gtest/gtest.h>
 
@@ -482,6 +484,90 @@ TEST(AdaptiveRepair, StopsWhenItWouldExtractTheSameSurfaceAgain)
   };
   computeIsosurface(sphere, 0.02, 0.04, false, nullptr, { 0.3, 0.0 }, nullptr, &wandering, 4);
   EXPECT_EQ(moving, 5) << "the first extraction and maxRepairs = 4 repairs";
+}
+
+// The verification that reuses what it found on the surface before (an adaptive envelope
+// re-extracted around its defects): on a sequence of surfaces that share most triangles, each
+// answer (verdict, reason, certified clearance, point distances) is the full check's, and the
+// defect flags are those of a brute-force test of every pair and every triangle's clearance.
+TEST(VerificationMemo, ReusedFindingsGiveTheFullCheckAnswer)
+{
+  const TriangleMesh input = makeSphere(Vec3(0, 0, 0), 0.5, 24, 12);
+  const TriangleMesh sound = makeSphere(Vec3(0.003, -0.002, 0.001), 0.56, 40, 20);
+  const double clearance = 0.02;
+  const TriangleTree tree(input);
+  // a vertex pushed to the input (clearance), one pulled through to the far side (its triangles
+  // cross the input and the triangles there)
+  TriangleMesh nearInput = sound, crossing = sound;
+  nearInput.Points[300] *= 0.5 / nearInput.Points[300].norm();
+  crossing.Points[500] = -1.05 * crossing.Points[500];
+  const auto bruteForce = [&](const TriangleMesh& m) {
+    const std::size_t nf = m.Triangles.size();
+    std::vector<char> flags(nf, 0);
+    const auto box = bounds(m);
+    const double touching = 1e-12 * std::max(1.0, (box[1] - box[0]).norm());
+    for (std::size_t f = 0; f < nf; ++f)
+    {
+      const Triangle& t = m.Triangles[f];
+      const int ia[3] = { t[0], t[1], t[2] };
+      const Vec3 pa[3] = { m.Points[t[0]], m.Points[t[1]], m.Points[t[2]] };
+      for (std::size_t g = f + 1; g < nf; ++g)
+      {
+        const Triangle& o = m.Triangles[g];
+        const int ib[3] = { o[0], o[1], o[2] };
+        const Vec3 pb[3] = { m.Points[o[0]], m.Points[o[1]], m.Points[o[2]] };
+        if (trianglesConflict(ia, pa, ib, pb, touching, -1.0 + 1e-12))
+          flags[f] = flags[g] = 1;
+      }
+      for (const Triangle& u : input.Triangles)
+      {
+        const Vec3 pu[3] = { input.Points[u[0]], input.Points[u[1]], input.Points[u[2]] };
+        if (std::sqrt(triangleTriangleDistance2(pa, pu)) < clearance)
+          flags[f] = 1;
+      }
+    }
+    return flags;
+  };
+  VerificationMemo memo;
+  const struct
+  {
+    const TriangleMesh* Surface;
+    bool Ok;
+    bool Reuses;
+  } sequence[] = { { &nearInput, false, false }, { &crossing, false, true }, { &sound, true, true } };
+  for (const auto& step : sequence)
+  {
+    SCOPED_TRACE(step.Surface == &sound ? "sound" : step.Surface == &crossing ? "crossing" : "near the input");
+    std::string why, fullWhy;
+    double measured = -1.0, fullMeasured = -1.0;
+    std::vector<double> distances, fullDistances;
+    const bool ok =
+      verifyEnclosureWithMemo(input, *step.Surface, clearance, measured, why, &distances, nullptr, tree, memo);
+    const bool fullOk =
+      verifyEnclosure(input, *step.Surface, clearance, fullMeasured, fullWhy, &fullDistances, nullptr, false, &tree);
+    EXPECT_EQ(ok, step.Ok) << why;
+    EXPECT_EQ(ok, fullOk);
+    EXPECT_EQ(why, fullWhy);
+    if (ok)
+    {
+      EXPECT_EQ(measured, fullMeasured);
+      EXPECT_GE(measured, clearance);
+      EXPECT_EQ(distances, fullDistances);
+    }
+    EXPECT_EQ(memo.Defective, bruteForce(*step.Surface));
+    // the surfaces differ in one vertex: all but its few triangles are taken from the memo
+    if (step.Reuses)
+      EXPECT_GE(memo.Reused, step.Surface->Triangles.size() - 24);
+    else
+      EXPECT_EQ(memo.Reused, 0u);
+  }
+  // another clearance: nothing reused
+  TriangleMesh again = nearInput;
+  std::string why;
+  double measured = 0.0;
+  EXPECT_FALSE(verifyEnclosureWithMemo(input, again, clearance, measured, why, nullptr, nullptr, tree, memo));
+  EXPECT_FALSE(verifyEnclosureWithMemo(input, again, 0.5 * clearance, measured, why, nullptr, nullptr, tree, memo));
+  EXPECT_EQ(memo.Reused, 0u);
 }
 
 TEST(Envelope, LargerIsoValueExplicitAndExactClearance)
