@@ -1168,7 +1168,17 @@ int writePicture(vtkPolyData* input, vtkPolyData* shown, bool verified, const Op
     shortNumber(r.number("MeasuredClearanceRelative")) + " relative)";
   progress->step("rendering " + std::filesystem::path(o.Screenshot).filename().string(), 1.0);
   std::string error;
-  if (!writeScreenshot(input, shown, title, o.Screenshot, error))
+  if (messages)
+  {
+    messages->clear(); // what VTK says while rendering is reported below
+  }
+  bool pictured = writeScreenshot(input, shown, title, o.Screenshot, error);
+  if (pictured && messages && !messages->errors().empty())
+  {
+    pictured = false; // VTK reported an error while rendering or writing
+    error = "cannot write the screenshot '" + o.Screenshot + "': " + messages->errors().front();
+  }
+  if (!pictured)
   {
     progress->finish();
     printError(error);
