@@ -811,15 +811,15 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
         return false; // computeIsosurface reports the cancel
       }
       // the envelope's parts and genus, computed once when first needed
-      std::vector<int> comp;
       int parts = -1, g = 0;
       bool usable = false;
       const auto topology = [&]() {
         if (parts < 0)
         {
-          parts = triangleComponents(envelope, comp);
-          usable = checkTriangleMesh(envelope).usable();
-          g = usable ? genus(envelope) : 0;
+          const MeshDefects d = checkTriangleMesh(envelope);
+          parts = d.Components;
+          usable = d.usable();
+          g = usable ? d.Genus : 0;
         }
       };
       if (coarseLevel && result.InputClosed)
@@ -863,6 +863,8 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
         topology();
         if (usable && fusedApart(g, parts, result.InputGenus, result.InputComponents, unitInput))
         {
+          result.Components = parts;
+          result.Genus = g;
           result.Envelope = std::move(envelope);
           result.RemovedPockets = pockets;
           result.VoxelSizeUsed = h;
@@ -891,14 +893,22 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
       double clearance = 0.0;
       std::vector<double> distances;
       // (deferred: accepted as extracted, the caller verifies it if it keeps it)
-      const bool withMemo = adaptivity > 0.0 && !options.ExactEnvelopeClearance;
+      const bool withMemo = adaptivity > 0.0 && !options.ExactEnvelopeClearance && !options.DeferVerification;
+      // (the manifold check, parts and genus of the surface as verified: the verification's
+      // first step, and the accepted envelope's parts and genus below)
+      const MeshDefects checked = withMemo ? checkTriangleMesh(envelope) : MeshDefects();
       const bool ok = options.DeferVerification ||
-        (withMemo
-            ? verifyEnclosureWithMemo(unitInput, envelope, delta, clearance, why, &distances, progress, tree(), memo)
-            : verifyEnclosure(unitInput, envelope, delta, clearance, why, &distances, progress,
-                options.ExactEnvelopeClearance, &tree()));
+        (withMemo ? verifyEnclosureWithMemo(
+                      unitInput, envelope, delta, clearance, why, &distances, progress, tree(), memo, &checked)
+                  : verifyEnclosure(unitInput, envelope, delta, clearance, why, &distances, progress,
+                      options.ExactEnvelopeClearance, &tree()));
       result.VerificationDeferred = options.DeferVerification;
       ++attempt;
+      if (ok && withMemo)
+      {
+        result.Components = checked.Components;
+        result.Genus = checked.usable() ? checked.Genus : genus(envelope);
+      }
       if (ok)
       {
         result.Envelope = std::move(envelope);
@@ -926,6 +936,14 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
         }
       }
       result.VerificationSeconds += seconds(t1);
+      if (ok && !withMemo)
+      {
+        // (the accepted envelope's parts and genus: not part of the verification's time, which
+        // is none for a deferred envelope)
+        const MeshDefects d = checkTriangleMesh(result.Envelope);
+        result.Components = d.Components;
+        result.Genus = d.usable() ? d.Genus : genus(result.Envelope);
+      }
       return ok;
     };
     IsosurfaceOutput iso =
@@ -958,9 +976,7 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
     }
     if (accepted && coarseLevel)
     {
-      std::vector<int> comp;
-      if (triangleComponents(result.Envelope, comp) != result.InputComponents ||
-        genus(result.Envelope) != result.InputGenus)
+      if (result.Components != result.InputComponents || result.Genus != result.InputGenus)
       {
         accepted = false; // fused on the coarse grid: the requested grid decides
         result.Envelope = TriangleMesh();
@@ -982,9 +998,7 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
     }
     if (accepted)
     {
-      std::vector<int> comp;
-      result.Components = triangleComponents(result.Envelope, comp);
-      result.Genus = genus(result.Envelope);
+      // (result.Components and result.Genus: the accepted envelope's, set by the judge)
       // the input's genus is defined for a closed input only
       if (result.InputClosed && (result.Genus != result.InputGenus || result.Components != result.InputComponents))
       {

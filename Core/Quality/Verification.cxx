@@ -304,7 +304,7 @@ struct VerificationMemo::Store
 
 bool verifyEnclosureWithMemo(const TriangleMesh& input, const TriangleMesh& surface, double clearance,
   double& measuredClearance, std::string& why, std::vector<double>* pointDistances, Progress* progress,
-  const TriangleTree& inputTree, VerificationMemo& memo)
+  const TriangleTree& inputTree, VerificationMemo& memo, const MeshDefects* checked)
 {
   measuredClearance = 0.0;
   why.clear();
@@ -348,7 +348,7 @@ bool verifyEnclosureWithMemo(const TriangleMesh& input, const TriangleMesh& surf
   std::vector<char>& defective = memo.Defective;
 
   // 0. closed 2-manifold (judged whole: it is cheap)
-  const MeshDefects d = checkTriangleMesh(surface);
+  const MeshDefects d = checked ? *checked : checkTriangleMesh(surface);
   std::string manifoldWhy;
   if (!d.usable())
     manifoldWhy = "the surface is not a closed 2-manifold: " + d.errorMessage();

@@ -14,6 +14,7 @@ namespace sdfcage
 
 class Progress;
 class TriangleTree;
+struct MeshDefects;
 
 /// Pairs of triangles of `mesh` that conflict (Spatial/Geometry.h trianglesConflict): sharing no
 /// vertex and closer than `touching` (or crossing), sharing one vertex and meeting elsewhere,
@@ -58,9 +59,10 @@ struct VerificationMemo
 /// test is the same) and its certified distance to the input; point distances are reused by
 /// position. Every pair involving a new triangle, every new triangle's clearance, the 2-manifold
 /// test and the winding numbers are checked as usual. Fills memo.Defective and replaces what the
-/// memo keeps with this surface's findings.
+/// memo keeps with this surface's findings. `checked`, if given, is checkTriangleMesh(surface)
+/// (saves computing it again).
 bool verifyEnclosureWithMemo(const TriangleMesh& input, const TriangleMesh& surface, double clearance,
   double& measuredClearance, std::string& why, std::vector<double>* pointDistances, Progress* progress,
-  const TriangleTree& inputTree, VerificationMemo& memo);
+  const TriangleTree& inputTree, VerificationMemo& memo, const MeshDefects* checked = nullptr);
 
 } // namespace sdfcage
