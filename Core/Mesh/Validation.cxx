@@ -528,7 +528,11 @@ MeshDefects checkTriangleMesh(const TriangleMesh& mesh)
   d.Components = triangleComponents(mesh, comp);
   if (d.usable())
   {
-    d.Genus = genus(mesh);
+    // a closed 2-manifold: every edge has exactly two triangles, so E = 3F/2 and
+    // chi = V - 3F/2 + F = 2 parts - 2 genus (genus() would sort the edges once more)
+    const long long f = static_cast<long long>(mesh.Triangles.size());
+    const long long chi = usedVertexCount(mesh) - f / 2;
+    d.Genus = static_cast<int>((2LL * d.Components - chi) / 2);
   }
   return d;
 }

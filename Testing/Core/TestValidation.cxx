@@ -408,6 +408,20 @@ TEST(Validation, TorusHasGenusOne)
   EXPECT_TRUE(e.usable()) << e.errorMessage();
   EXPECT_EQ(e.Genus, 2);
   EXPECT_EQ(e.Components, 3);
+
+  // checkTriangleMesh counts the edges of a closed mesh as 3F/2: the same genus as genus(), with
+  // points no triangle uses left in, and with the built-in shape (a torus beside a sphere) added
+  more.Points.push_back(Vec3(9, 9, 9));
+  const MeshDefects f = checkTriangleMesh(more);
+  EXPECT_TRUE(f.usable()) << f.errorMessage();
+  EXPECT_EQ(f.Genus, 2);
+  EXPECT_EQ(f.Components, 3);
+  EXPECT_EQ(genus(more), 2);
+  appendMesh(more, makeBuiltinShape());
+  EXPECT_TRUE(checkTriangleMesh(more).usable());
+  EXPECT_EQ(checkTriangleMesh(more).Genus, 3);
+  EXPECT_EQ(genus(more), 3);
+  EXPECT_EQ(checkTriangleMesh(torus).Genus, 1);
 }
 
 TEST(Validation, UnreferencedPointsAndIgnoredCellsAreDropped)
