@@ -52,21 +52,63 @@ bool componentsInside(const TriangleMesh& input, const TriangleMesh& cage, std::
   return true;
 }
 
+/// Disjoint triangles closer than this (relative to the mesh size) count as touching.
+double touchingTolerance(const TriangleMesh& mesh)
+{
+  const auto box = bounds(mesh);
+  return 1e-12 * std::max(1.0, (box[1] - box[0]).norm());
+}
+
+/// Calls visit(g) for every triangle g != f of `mesh` (indexed by `index`) that conflicts with
+/// triangle f (trianglesConflict, exact-intersection fold test) and that `consider(g)` admits;
+/// consider runs before the exact test.
+template <typename Consider, typename Visit>
+void forEachConflict(const TriangleMesh& mesh, const TriangleIndex& index, std::size_t f, double touching,
+  Consider&& consider, Visit&& visit)
+{
+  // exact-intersection fold test for edge-sharing pairs: only exactly opposite normals overlap
+  const double foldCosine = -1.0 + 1e-12;
+  const Triangle& t = mesh.Triangles[f];
+  const int ia[3] = { t[0], t[1], t[2] };
+  const Vec3 pa[3] = { mesh.Points[t[0]], mesh.Points[t[1]], mesh.Points[t[2]] };
+  const Vec3 pad = Vec3::Constant(touching);
+  const Vec3 lo = pa[0].cwiseMin(pa[1]).cwiseMin(pa[2]) - pad;
+  const Vec3 hi = pa[0].cwiseMax(pa[1]).cwiseMax(pa[2]) + pad;
+  index.forEachTriangleInBox(lo, hi, [&](int g) {
+    if (static_cast<std::size_t>(g) == f || !consider(g))
+      return;
+    const Triangle& o = mesh.Triangles[g];
+    const int ib[3] = { o[0], o[1], o[2] };
+    const Vec3 pb[3] = { mesh.Points[o[0]], mesh.Points[o[1]], mesh.Points[o[2]] };
+    if (trianglesConflict(ia, pa, ib, pb, touching, foldCosine))
+      visit(g);
+  });
+}
+
+/// A lower bound of triangle t's distance to the input from its corners' distances `dist`: the
+/// distance changes by at most the distance travelled.
+double cornerBound(const TriangleMesh& mesh, const Triangle& t, const std::vector<double>& dist)
+{
+  double lower = -std::numeric_limits<double>::infinity();
+  for (int i = 0; i < 3; ++i)
+  {
+    const Vec3& p = mesh.Points[t[i]];
+    const double reach = std::max((mesh.Points[t[(i + 1) % 3]] - p).norm(), (mesh.Points[t[(i + 2) % 3]] - p).norm());
+    lower = std::max(lower, dist[t[i]] - reach);
+  }
+  return lower;
+}
+
 } // namespace
 
 long long countSelfIntersections(const TriangleMesh& mesh, Progress* progress, double touching)
 {
   TriangleIndex index;
   index.build(mesh);
-  // exact-intersection fold test for edge-sharing pairs: only exactly opposite normals overlap
-  const double foldCosine = -1.0 + 1e-12;
   if (!(touching >= 0.0))
   {
-    // disjoint triangles closer than this (relative to the mesh size) count as touching
-    const auto box = bounds(mesh);
-    touching = 1e-12 * std::max(1.0, (box[1] - box[0]).norm());
+    touching = touchingTolerance(mesh);
   }
-  const Vec3 pad = Vec3::Constant(touching);
   return tbb::parallel_reduce(
     tbb::blocked_range<std::size_t>(0, mesh.Triangles.size(), 256), 0LL,
     [&](const tbb::blocked_range<std::size_t>& r, long long count) {
@@ -76,21 +118,9 @@ long long countSelfIntersections(const TriangleMesh& mesh, Progress* progress, d
       }
       for (std::size_t f = r.begin(); f != r.end(); ++f)
       {
-        const Triangle& t = mesh.Triangles[f];
-        const int ia[3] = { t[0], t[1], t[2] };
-        const Vec3 pa[3] = { mesh.Points[t[0]], mesh.Points[t[1]], mesh.Points[t[2]] };
-        const Vec3 lo = pa[0].cwiseMin(pa[1]).cwiseMin(pa[2]) - pad;
-        const Vec3 hi = pa[0].cwiseMax(pa[1]).cwiseMax(pa[2]) + pad;
-        index.forEachTriangleInBox(lo, hi, [&](int g) {
-          if (static_cast<std::size_t>(g) <= f)
-          {
-            return;
-          }
-          const Triangle& o = mesh.Triangles[g];
-          const int ib[3] = { o[0], o[1], o[2] };
-          const Vec3 pb[3] = { mesh.Points[o[0]], mesh.Points[o[1]], mesh.Points[o[2]] };
-          count += trianglesConflict(ia, pa, ib, pb, touching, foldCosine) ? 1 : 0;
-        });
+        // each pair once, from its smaller id
+        forEachConflict(
+          mesh, index, f, touching, [f](int g) { return static_cast<std::size_t>(g) > f; }, [&](int) { ++count; });
       }
       return count;
     },
@@ -161,14 +191,7 @@ bool verifyEnclosure(const TriangleMesh& input, const TriangleMesh& cage, double
   double certified = upper;
   for (std::size_t f = 0; f < nf; ++f)
   {
-    const Triangle& t = cage.Triangles[f];
-    double lower = -std::numeric_limits<double>::infinity();
-    for (int i = 0; i < 3; ++i)
-    {
-      const Vec3& p = cage.Points[t[i]];
-      const double reach = std::max((cage.Points[t[(i + 1) % 3]] - p).norm(), (cage.Points[t[(i + 2) % 3]] - p).norm());
-      lower = std::max(lower, dist[t[i]] - reach);
-    }
+    const double lower = cornerBound(cage, cage.Triangles[f], dist);
     if (lower < stopAt)
     {
       uncertain.emplace_back(lower, static_cast<int>(f));
@@ -309,8 +332,7 @@ bool verifyEnclosureWithMemo(const TriangleMesh& input, const TriangleMesh& surf
   measuredClearance = 0.0;
   why.clear();
   const std::size_t nv = surface.Points.size(), nf = surface.Triangles.size();
-  const auto box = bounds(surface);
-  const double touching = 1e-12 * std::max(1.0, (box[1] - box[0]).norm());
+  const double touching = touchingTolerance(surface);
   // what the memo may give: same input and clearance, a tolerance for touching at least ours
   std::shared_ptr<const VerificationMemo::Store> known = memo.Known;
   if (known && (known->Input != &input || known->Clearance != clearance || known->Touching < touching))
@@ -359,8 +381,6 @@ bool verifyEnclosureWithMemo(const TriangleMesh& input, const TriangleMesh& surf
   {
     TriangleIndex index;
     index.build(surface);
-    const double foldCosine = -1.0 + 1e-12;
-    const Vec3 pad = Vec3::Constant(touching);
     tbb::enumerable_thread_specific<std::vector<int>> partners;
     conflicts = tbb::parallel_reduce(
       tbb::blocked_range<std::size_t>(0, nf, 256), 0LL,
@@ -372,26 +392,16 @@ bool verifyEnclosureWithMemo(const TriangleMesh& input, const TriangleMesh& surf
         {
           if (knownBound[f] >= 0.0)
             continue;
-          const Triangle& t = surface.Triangles[f];
-          const int ia[3] = { t[0], t[1], t[2] };
-          const Vec3 pa[3] = { surface.Points[t[0]], surface.Points[t[1]], surface.Points[t[2]] };
-          const Vec3 lo = pa[0].cwiseMin(pa[1]).cwiseMin(pa[2]) - pad;
-          const Vec3 hi = pa[0].cwiseMax(pa[1]).cwiseMax(pa[2]) + pad;
-          index.forEachTriangleInBox(lo, hi, [&](int g) {
-            if (static_cast<std::size_t>(g) == f)
-              return;
-            const bool gKnown = knownBound[g] >= 0.0;
-            const Triangle& o = surface.Triangles[g];
-            const int ib[3] = { o[0], o[1], o[2] };
-            const Vec3 pb[3] = { surface.Points[o[0]], surface.Points[o[1]], surface.Points[o[2]] };
-            if (!trianglesConflict(ia, pa, ib, pb, touching, foldCosine))
-              return;
-            defective[f] = 1; // each new triangle writes only its own flag here
-            if (gKnown)
-              mine.push_back(g);
-            if (gKnown || static_cast<std::size_t>(g) > f)
-              ++count;
-          });
+          forEachConflict(
+            surface, index, f, touching, [](int) { return true; },
+            [&](int g) {
+              const bool gKnown = knownBound[g] >= 0.0;
+              defective[f] = 1; // each new triangle writes only its own flag here
+              if (gKnown)
+                mine.push_back(g);
+              if (gKnown || static_cast<std::size_t>(g) > f)
+                ++count;
+            });
         }
         return count;
       },
@@ -445,14 +455,7 @@ bool verifyEnclosureWithMemo(const TriangleMesh& input, const TriangleMesh& surf
         continue;
       }
       const Triangle& t = surface.Triangles[f];
-      double lower = -std::numeric_limits<double>::infinity();
-      for (int i = 0; i < 3; ++i)
-      {
-        const Vec3& p = surface.Points[t[i]];
-        const double reach =
-          std::max((surface.Points[t[(i + 1) % 3]] - p).norm(), (surface.Points[t[(i + 2) % 3]] - p).norm());
-        lower = std::max(lower, dist[t[i]] - reach);
-      }
+      const double lower = cornerBound(surface, t, dist);
       if (lower >= clearance)
       {
         bound[f] = lower;
