@@ -1652,10 +1652,18 @@ double sampledHausdorff(const TriangleMesh& cage, const TriangleTree& tree, Prog
 /// Area fraction of the cage whose distance to the input lies within [lo, hi]: every triangle
 /// cut into 4^3 = 64 by three rounds of midpoint subdivision, each piece judged at its centroid
 /// (exact distances through the input's tree); per triangle in parallel, summed in order.
-double areaWithinBand(const TriangleMesh& cage, const TriangleTree& tree, double lo, double hi)
+/// Area fractions of the cage closer than lo to the input, within [lo, hi], and farther than hi.
+struct BandAreas
+{
+  double Closer = 0.0;
+  double Within = 0.0;
+  double Farther = 0.0;
+};
+
+BandAreas bandAreas(const TriangleMesh& cage, const TriangleTree& tree, double lo, double hi)
 {
   const std::size_t n = cage.Triangles.size();
-  std::vector<double> inside(n, 0.0), area(n, 0.0);
+  std::vector<double> inside(n, 0.0), closer(n, 0.0), area(n, 0.0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, n, 16), [&](const tbb::blocked_range<std::size_t>& range) {
     std::vector<std::array<Vec3, 3>> pieces, next;
     for (std::size_t f = range.begin(); f != range.end(); ++f)
@@ -1682,16 +1690,26 @@ double areaWithinBand(const TriangleMesh& cage, const TriangleTree& tree, double
         area[f] += a;
         if (d >= lo && d <= hi)
           inside[f] += a;
+        else if (d < lo)
+          closer[f] += a;
       }
     }
   });
-  double in = 0.0, all = 0.0;
+  double in = 0.0, near = 0.0, all = 0.0;
   for (std::size_t f = 0; f < n; ++f)
   {
     in += inside[f];
+    near += closer[f];
     all += area[f];
   }
-  return all > 0.0 ? in / all : 0.0;
+  BandAreas b;
+  if (all > 0.0)
+  {
+    b.Within = in / all;
+    b.Closer = near / all;
+    b.Farther = std::max(0.0, 1.0 - b.Within - b.Closer);
+  }
+  return b;
 }
 
 double smallAngleFraction(const TriangleMesh& cage, double angle)
@@ -1810,7 +1828,7 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
   r.SmallAnglesBefore = smallAngleFraction(cage, options.TargetMinimumAngle);
   r.HausdorffBefore = sampledHausdorff(cage, inputTree, progress);
   if (!mipsMode)
-    r.SpacingBandBefore = areaWithinBand(cage, inputTree, 0.8 * options.TargetSpacing, 1.2 * options.TargetSpacing);
+    r.SpacingBandBefore = bandAreas(cage, inputTree, 0.8 * options.TargetSpacing, 1.2 * options.TargetSpacing).Within;
   if (progressCancelled(progress))
   {
     // the given cage, verified above (its distances are not measured again)
@@ -1987,7 +2005,12 @@ OptimizeResult optimizeCage(const TriangleMesh& cage, const TriangleMesh& input,
   // after a cancel, bounded by the verification's grace (then a lower bound)
   r.HausdorffAfter = sampledHausdorff(r.Cage, inputTree, progress ? &grace : nullptr);
   if (!mipsMode)
-    r.SpacingBandAfter = areaWithinBand(r.Cage, inputTree, 0.8 * options.TargetSpacing, 1.2 * options.TargetSpacing);
+  {
+    const BandAreas after = bandAreas(r.Cage, inputTree, 0.8 * options.TargetSpacing, 1.2 * options.TargetSpacing);
+    r.SpacingBandAfter = after.Within;
+    r.SpacingCloserAfter = after.Closer;
+    r.SpacingFartherAfter = after.Farther;
+  }
   if (progress && grace.expired() && r.Message.find("lower bound") == std::string::npos)
     r.Message += std::string(r.Message.empty() ? "" : "; ") + "HausdorffAfter is a lower bound (cut short by the cancel)";
   r.State = cancelled ? Status::Cancelled : Status::Ok;

@@ -129,6 +129,11 @@ struct OptimizeResult
   /// TargetSpacing +- 20% (each triangle judged at the centroids of its 64 midpoint pieces).
   double SpacingBandBefore = 0.0;
   double SpacingBandAfter = 0.0;
+  /// ... and the rest of the result's area, split: closer than 0.8 TargetSpacing to the input
+  /// (where the cage cannot follow the input at that distance with its vertices, or a narrow gap
+  /// keeps it close), farther than 1.2 TargetSpacing (concavities the cage spans).
+  double SpacingCloserAfter = 0.0;
+  double SpacingFartherAfter = 0.0;
   double HausdorffBudget = 0.0;
   double SmallAnglesBefore = 0.0; ///< fraction of triangle angles below TargetMinimumAngle (MIPS)
   double SmallAnglesAfter = 0.0;

@@ -121,6 +121,10 @@ ResultTable optimizationStatistics(const OptimizeResult& o)
     real("SpacingBandBefore", 100 * o.SpacingBandBefore, "percent",
       "spacing energy: area of the cage at TargetSpacing +- 20% from the input, before the optimization"),
     real("SpacingBandAfter", 100 * o.SpacingBandAfter, "percent", "the same after the optimization"),
+    real("SpacingCloserAfter", 100 * o.SpacingCloserAfter, "percent",
+      "spacing energy: area of the optimized cage closer than 0.8 TargetSpacing to the input"),
+    real("SpacingFartherAfter", 100 * o.SpacingFartherAfter, "percent",
+      "spacing energy: area of the optimized cage farther than 1.2 TargetSpacing from the input"),
     real("OptimizationPartRoom", o.PartClearanceUsed, "relative",
       "distance the optimization kept between the cage's parts: as the simplified cage had them (nested levels; "
       "0: none)"),

@@ -242,6 +242,23 @@ TEST(Optimization, SpacingConcentratesAroundTarget)
   EXPECT_NEAR(r.SpacingBandBefore, b0, 0.03);
   EXPECT_NEAR(r.SpacingBandAfter, b1, 0.03);
   EXPECT_GT(r.SpacingBandAfter, r.SpacingBandBefore + 0.2);
+  // the rest of the area split into closer than 0.8 h and farther than 1.2 h, each as measured here
+  const double closer = bandFraction(n.toUnit(r.Cage), tree, 0.0, 0.8 * h);
+  std::cout << "[ spacing  ] after: closer " << r.SpacingCloserAfter << " (measured here " << closer << "), farther "
+            << r.SpacingFartherAfter << " (" << 1.0 - b1 - closer << ")\n";
+  EXPECT_NEAR(r.SpacingCloserAfter, closer, 0.03);
+  EXPECT_NEAR(r.SpacingFartherAfter, 1.0 - b1 - closer, 0.03);
+  EXPECT_NEAR(r.SpacingBandAfter + r.SpacingCloserAfter + r.SpacingFartherAfter, 1.0, 1e-9);
+  // the plain cage lies about the isovalue (0.01) from the input: below the band almost wholly
+  const OptimizeOptions none = [&] {
+    OptimizeOptions z = o;
+    z.NumberOfIterations = 0;
+    return z;
+  }();
+  const OptimizeResult plain = optimizeCageInInputUnits(cage.Cage, input, none);
+  ASSERT_EQ(plain.State, Status::Ok) << plain.Message;
+  EXPECT_GT(plain.SpacingCloserAfter, 0.9) << "the plain cage at about 0.01 from the input, h = " << h;
+  EXPECT_LT(plain.SpacingFartherAfter, 0.05);
 }
 
 TEST(Optimization, CCDCutsAMoveThroughATriangleShort)
