@@ -5,7 +5,8 @@
 // cage -> input before and after (certified by the quality judge, evaluateCage, relative to the
 // input's bounding-box diagonal), the optimization time, whether the result encloses, and for
 // the spacing energy the fraction of the cage's area whose distance to the input lies within
-// h +- 20% (h in unit-sphere units, as --spacing).
+// h +- 20% (h in unit-sphere units, as --spacing), with the rest split into closer and farther
+// (the optimizer's own SpacingCloserAfter / SpacingFartherAfter) on a line below.
 //
 //   sdfcage_tight_benchmark [--vertices N] [--cages DIR] [--no-spacing] [--no-mips] [--sweeps K]
 //                           [--spacing-rounds K] [--threads N] [--verbose] [FILES...]
@@ -203,13 +204,14 @@ int main(int argc, char** argv)
     const bool ok = r.State == Status::Ok && !r.Reverted && q1.Encloses;
     if (!ok)
       status = 1;
-    char angles[64], small[64], hd[64], band[2][64];
+    char angles[64], small[64], hd[64], band[2][64], split[2][96];
     std::snprintf(angles, sizeof angles, "%5.2f -> %5.2f", minimumAngle(unitCage), minimumAngle(r.Cage));
     std::snprintf(small, sizeof small, "%4.1f -> %4.1f", 100 * smallAngles(unitCage, 15), 100 * smallAngles(r.Cage, 15));
     std::snprintf(hd, sizeof hd, "%.4f -> %.4f", h0, h1);
     for (int k = 0; k < 2; ++k)
     {
       std::snprintf(band[k], sizeof band[k], "-");
+      split[k][0] = '\0';
       if (!spacing)
         continue;
       const double h = k == 0 ? 0.03 : 0.05;
@@ -227,9 +229,13 @@ int main(int argc, char** argv)
       }
       std::snprintf(band[k], sizeof band[k], "%4.1f%% -> %4.1f%%", 100 * bandFraction(unitCage, tree, 0.8 * h, 1.2 * h),
         100 * bandFraction(s.Cage, tree, 0.8 * h, 1.2 * h));
+      std::snprintf(split[k], sizeof split[k], "h=%.2f: closer than 0.8h %.1f%%, farther than 1.2h %.1f%%", h,
+        100 * s.SpacingCloserAfter, 100 * s.SpacingFartherAfter);
     }
     std::printf("%-22s | %-16s | %-13s | %-21s | %6.2f | %6.1f | %-8s | %-14s | %-14s\n", stem(path).c_str(), angles,
       small, hd, h0 > 0 ? h1 / h0 : 0.0, r.Seconds, ok ? "yes" : "NO", band[0], band[1]);
+    if (spacing)
+      std::printf("    spacing, the rest of the area: %s; %s\n", split[0], split[1]);
     if (verbose)
       std::printf("    mips: %d sweeps, moves %lld (rejected %lld: energy %lld, collision %lld, shape %lld, self %lld, "
                   "fidelity %lld), flips %lld (vetoed %lld), collapses+splits %lld (vetoed %lld), angle moves %lld, "
