@@ -318,6 +318,22 @@ std::string fileBytes(const std::string& path)
 
 } // namespace
 
+// An element without properties takes no bytes whatever its count, so the count is not bounded
+// by the file's size: nothing may be reserved for it (a 'face' element of 948 million such made
+// the parser reserve 7.6 GB; found by fuzz_mesh_parsers, kept as its regression input).
+TEST(PLYParser, AnElementWithoutPropertiesReservesNothing)
+{
+  const std::string text = "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                           "property float z\nelement face 100000000\nend_header\n0 0 0\n1 0 0\n0 1 0\n";
+  sdfcage_cli::ParsedMesh mesh;
+  std::string error;
+  ASSERT_TRUE(sdfcage_cli::parsePLY(text.data(), text.size(), mesh, error)) << error;
+  EXPECT_EQ(mesh.Points.size(), 9u);
+  EXPECT_EQ(mesh.Offsets.size(), 1u); // no face read
+  EXPECT_LT(mesh.Offsets.capacity(), 1000u);
+  EXPECT_LT(mesh.Connectivity.capacity(), 1000u);
+}
+
 TEST(STLParser, ReadsWhatVTKWritesLikeVTKReadsIt)
 {
   vtkNew<vtkSphereSource> sphere;
