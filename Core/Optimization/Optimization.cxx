@@ -1649,10 +1649,8 @@ double sampledHausdorff(const TriangleMesh& cage, const TriangleTree& tree, Prog
   }
   return lower;
 }
-/// Area fraction of the cage whose distance to the input lies within [lo, hi]: every triangle
-/// cut into 4^3 = 64 by three rounds of midpoint subdivision, each piece judged at its centroid
-/// (exact distances through the input's tree); per triangle in parallel, summed in order.
-/// Area fractions of the cage closer than lo to the input, within [lo, hi], and farther than hi.
+/// Area fractions of a cage by its distance to the input: closer than lo, within [lo, hi],
+/// farther than hi.
 struct BandAreas
 {
   double Closer = 0.0;
@@ -1660,6 +1658,9 @@ struct BandAreas
   double Farther = 0.0;
 };
 
+/// The cage's BandAreas: every triangle cut into 4^3 = 64 by three rounds of midpoint
+/// subdivision, each piece judged at its centroid (exact distances through the input's tree);
+/// per triangle in parallel, summed in order.
 BandAreas bandAreas(const TriangleMesh& cage, const TriangleTree& tree, double lo, double hi)
 {
   const std::size_t n = cage.Triangles.size();
