@@ -1,7 +1,8 @@
 // SDFCage — CLI: the OBJ parser (see CLIParsers.h).
 #include "CLIParsers.h"
 
-#include <cerrno>
+#include <algorithm>
+#include <charconv>
 #include <cstdlib>
 #include <cstring>
 #include <limits>
@@ -18,43 +19,66 @@ bool isSpace(char c)
   return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f';
 }
 
-/// The next white-space separated token of [p, end), copied (at most 255 characters).
-bool nextToken(const char*& p, const char* end, std::string& token)
+/// A token of the line: [Begin, End) in the file's bytes (no copy).
+struct Token
+{
+  const char* Begin = nullptr;
+  const char* End = nullptr;
+  std::size_t size() const { return static_cast<std::size_t>(End - Begin); }
+  std::string str(std::size_t most) const { return std::string(Begin, Begin + std::min(most, size())); }
+};
+
+/// The next white-space separated token of [p, end).
+bool nextToken(const char*& p, const char* end, Token& token)
 {
   while (p < end && isSpace(*p))
   {
     ++p;
   }
-  const char* start = p;
+  token.Begin = p;
   while (p < end && !isSpace(*p))
   {
     ++p;
   }
-  token.assign(start, p);
-  return !token.empty();
+  token.End = p;
+  return token.size() > 0;
 }
 
-bool parseNumber(const std::string& token, double& value)
+/// A coordinate: std::from_chars (no locale, no copy: reading armadillo.obj's 4 MB took 0.041 s
+/// with a copy and strtod per token), and strtod for what only it accepts (a leading '+', hex
+/// floats, overflow to inf), on a copy of at most 255 characters. "nan" and "inf" are kept for
+/// validation.
+bool parseNumber(const Token& token, double& value)
 {
-  if (token.empty() || token.size() > 255)
+  if (token.size() == 0 || token.size() > 255)
   {
     return false;
   }
+  const std::from_chars_result r = std::from_chars(token.Begin, token.End, value);
+  if (r.ec == std::errc() && r.ptr == token.End)
+  {
+    return true;
+  }
+  const std::string copy(token.Begin, token.End);
   char* end = nullptr;
-  value = std::strtod(token.c_str(), &end); // "nan", "inf" and overflows (inf) are kept for validation
-  return end == token.c_str() + token.size();
+  value = std::strtod(copy.c_str(), &end);
+  return end == copy.c_str() + copy.size();
 }
 
-bool parseIndex(const std::string& text, long long& value)
+/// A face corner's vertex index: the digits before any '/' (with an optional sign).
+bool parseIndex(const char* begin, const char* end, long long& value)
 {
-  if (text.empty() || text.size() > 20)
+  if (begin == end || end - begin > 20)
   {
     return false;
   }
-  char* end = nullptr;
-  errno = 0;
-  value = std::strtoll(text.c_str(), &end, 10);
-  return end == text.c_str() + text.size() && errno != ERANGE;
+  const char* digits = begin + (*begin == '+' ? 1 : 0);
+  if (digits == end || *digits == '+')
+  {
+    return false;
+  }
+  const std::from_chars_result r = std::from_chars(digits, end, value, 10);
+  return r.ec == std::errc() && r.ptr == end;
 }
 
 } // namespace
@@ -80,7 +104,7 @@ bool parseOBJ(
   std::vector<long long> faceLines; // the line of each face, for the message
   const char* p = data;
   const char* const fileEnd = data + size;
-  std::string keyword, token;
+  Token keyword, token;
   while (p < fileEnd)
   {
     const char* lineEnd = static_cast<const char*>(std::memchr(p, '\n', static_cast<std::size_t>(fileEnd - p)));
@@ -101,11 +125,11 @@ bool parseOBJ(
     {
       return fail("a NUL byte: not a text OBJ file");
     }
-    if (!nextToken(q, lineEnd, keyword) || keyword[0] == '#')
+    if (!nextToken(q, lineEnd, keyword) || keyword.Begin[0] == '#')
     {
       continue;
     }
-    if (keyword == "v")
+    if (keyword.size() == 1 && keyword.Begin[0] == 'v')
     {
       double xyz[3];
       for (double& c : xyz)
@@ -117,23 +141,24 @@ bool parseOBJ(
       }
       mesh.Points.insert(mesh.Points.end(), xyz, xyz + 3);
     }
-    else if (keyword == "f")
+    else if (keyword.size() == 1 && keyword.Begin[0] == 'f')
     {
       const long long vertices = static_cast<long long>(mesh.Points.size() / 3);
       std::size_t count = 0;
       while (nextToken(q, lineEnd, token))
       {
         long long index = 0;
-        if (!parseIndex(token.substr(0, token.find('/')), index) || index == 0)
+        const char* slash = static_cast<const char*>(std::memchr(token.Begin, '/', token.size()));
+        if (!parseIndex(token.Begin, slash ? slash : token.End, index) || index == 0)
         {
-          return fail("'" + token.substr(0, 40) + "' is not a vertex index (1-based, negative = relative)");
+          return fail("'" + token.str(40) + "' is not a vertex index (1-based, negative = relative)");
         }
         if (index < 0)
         {
           index += vertices; // -1: the last vertex read
           if (index < 0)
           {
-            return fail("relative index " + token.substr(0, 40) + " reaches before the first vertex");
+            return fail("relative index " + token.str(40) + " reaches before the first vertex");
           }
         }
         else

@@ -18,8 +18,9 @@
 // 1e400 as the largest double, without a word. This parser takes "v x y z [w]" (w ignored) and
 // "f a b c ..." (each a, a/t, a//n or a/t/n; 1-based, negative = relative to the last vertex)
 // and refuses any malformed number or index; other statements (vt, vn, g, o, s, usemtl,
-// mtllib, l, p, ...) are skipped. Numbers are read with strtod: "nan" and "inf" stay what they
-// are, so that the pipeline's validation refuses them by name.
+// mtllib, l, p, ...) are skipped. Numbers are read as strtod reads them (std::from_chars, and
+// strtod itself for what only it accepts): "nan" and "inf" stay what they are, so that the
+// pipeline's validation refuses them by name.
 #pragma once
 
 #include <cstddef>

@@ -4,7 +4,7 @@
 // METADATA, triangle strips, lines and vertices), it must read the same points and the same
 // triangles as vtkPolyDataReader. STL: on what vtkSTLWriter writes (ASCII and binary), the same
 // merged points and triangles as vtkSTLReader with merging. Both must refuse damaged files with a
-// reason.
+// reason. OBJ: numbers bit for bit as strtod reads them, face corners as before.
 #include "CLIParsers.h"
 
 #include <vtkCellArray.h>
@@ -32,6 +32,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <fstream>
 #include <iterator>
 #include <array>
@@ -628,4 +632,68 @@ TEST(AppendedXML, InlineFilesAreCopiedAndDamagedOnesRefusedWithAReason)
   }
   EXPECT_FALSE(sdfcage_cli::inlineAppendedXML(big, out, error));
   EXPECT_NE(error.find("size runs past"), std::string::npos) << error;
+}
+
+// The OBJ parser reads numbers with std::from_chars and falls back to strtod for what only strtod
+// accepts: every coordinate must be the very double strtod gives (bit for bit), including a
+// leading '+', hex floats, overflow to inf, "nan", denormals and many digits; and face corners
+// (a, a/t, a//n, a/t/n, signed, relative) as strtoll read them before.
+TEST(OBJParser, NumbersAreWhatStrtodReadsAndIndicesWhatStrtollReads)
+{
+  std::vector<std::string> words = { "0", "-0", "+1.5", "1e400", "-1e400", "nan", "inf", "-inf", "0x1.8p1", "1e-320",
+    "2.2250738585072014e-308", "0.1", ".5", "5.", "-.25e+2", "123456789012345678901234567890",
+    "0.333333333333333314829616256247390992939472198486328125", "1E5", "+.0e-0" };
+  // and many random values printed the ways exporters print them
+  unsigned seed = 12345u;
+  auto next = [&seed]() {
+    seed = seed * 1664525u + 1013904223u;
+    return seed;
+  };
+  for (int i = 0; i < 600; ++i)
+  {
+    const double v =
+      (static_cast<double>(next()) / 4294967296.0 - 0.5) * std::pow(10.0, static_cast<int>(next() % 13) - 6);
+    char buffer[64];
+    const char* formats[] = { "%.17g", "%.6f", "%e", "%.9g", "%.3e" };
+    std::snprintf(buffer, sizeof buffer, formats[i % 5], v);
+    words.push_back(buffer);
+  }
+  while (words.size() % 3 != 0)
+    words.push_back("7");
+  std::string text = "# comment\nmtllib a.mtl\no part\n";
+  for (std::size_t i = 0; i < words.size(); i += 3)
+    text += "v " + words[i] + "\t" + words[i + 1] + "  " + words[i + 2] + " 1.0\r\n";
+  text += "vt 0.5 0.5\nvn 0 0 1\ns off\n";
+  text += "f 1 2 3\nf 1/1 2/1 3/1\nf 1//1 2//1 3//1\nf 1/1/1 2/1/1 3/1/1 4/1/1\nf -3 -2 -1\nf +1 +2 +3\nf 1 2\n";
+  sdfcage_cli::ParsedMesh mesh;
+  std::string error;
+  ASSERT_TRUE(sdfcage_cli::parseOBJ(text.data(), text.size(), mesh, error)) << error;
+  ASSERT_EQ(mesh.Points.size(), words.size());
+  for (std::size_t i = 0; i < words.size(); ++i)
+  {
+    const double expected = std::strtod(words[i].c_str(), nullptr);
+    const double got = mesh.Points[i];
+    if (std::isnan(expected))
+      EXPECT_TRUE(std::isnan(got)) << words[i];
+    else
+      EXPECT_EQ(std::memcmp(&expected, &got, sizeof got), 0) << words[i] << ": " << got << " against " << expected;
+  }
+  const std::int64_t n = static_cast<std::int64_t>(words.size() / 3);
+  const std::vector<std::int64_t> offsets = { 0, 3, 6, 9, 13, 16, 19 };
+  const std::vector<std::int64_t> connectivity = { 0, 1, 2, 0, 1, 2, 0, 1, 2, 0, 1, 2, 3, n - 3, n - 2, n - 1, 0, 1,
+    2 };
+  EXPECT_EQ(mesh.Offsets, offsets);
+  EXPECT_EQ(mesh.Connectivity, connectivity);
+  EXPECT_EQ(mesh.SkippedFaces, 1);
+
+  // refused, each with a reason naming the line
+  for (const char* bad : { "v 1 2\n", "v 1 2 x\n", "v 1 2 3e\n", "v 1 2 --3\n", "v 1 2 ++3\n", "v 1 2 3\nf 1a 1 1\n",
+         "v 1 2 3\nf ++1 1 1\n", "v 1 2 3\nf 0 1 1\n", "v 1 2 3\nf 1 1 2\n", "v 1 2 3\nf -2 1 1\n",
+         "v 1 2 3\nf 99999999999999999999999 1 1\n", "v 1 2 3\nf /1 1 1\n", "v 1 2 3\nf - 1 1\n" })
+  {
+    const std::string b(bad);
+    error.clear();
+    EXPECT_FALSE(sdfcage_cli::parseOBJ(b.data(), b.size(), mesh, error)) << b;
+    EXPECT_NE(error.find("line "), std::string::npos) << b << ": " << error;
+  }
 }
