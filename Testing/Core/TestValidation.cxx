@@ -5,8 +5,13 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <set>
+#include <vector>
 #include <string>
 
 using namespace sdfcage;
@@ -445,4 +450,194 @@ TEST(Validation, UnreferencedPointsAndIgnoredCellsAreDropped)
     EXPECT_LE(p.maxCoeff(), 1.0);
   }
   EXPECT_NEAR(signedVolume(out), 1.0, 1e-12);
+}
+
+// checkTriangleMesh classifies each undirected edge around its lower vertex (Validation.cxx): on
+// meshes damaged at random (triangles removed, flipped, duplicated, extra triangles on existing
+// edges, repeated corners) its counts must equal a brute-force count over all edges (a map from
+// each undirected edge to the directions of its triangles) and, for the vertices, the number of
+// fans found by walking each vertex's triangles through shared edges.
+TEST(Validation, EdgeAndVertexCountsEqualABruteForceCount)
+{
+  unsigned seed = 7u;
+  auto next = [&seed](unsigned m) {
+    seed = seed * 1664525u + 1013904223u;
+    return (seed >> 8) % m;
+  };
+  for (int trial = 0; trial < 60; ++trial)
+  {
+    SCOPED_TRACE(trial);
+    TriangleMesh m = makeSphere(Vec3(0, 0, 0), 1.0, 5 + static_cast<int>(next(6)), 4 + static_cast<int>(next(5)));
+    const int nv = static_cast<int>(m.Points.size());
+    const int damage = static_cast<int>(next(6));
+    for (int k = 0; k < damage; ++k)
+    {
+      const std::size_t f = next(static_cast<unsigned>(m.Triangles.size()));
+      switch (next(5))
+      {
+        case 0: // removed
+          m.Triangles.erase(m.Triangles.begin() + static_cast<std::ptrdiff_t>(f));
+          break;
+        case 1: // flipped
+          std::swap(m.Triangles[f][1], m.Triangles[f][2]);
+          break;
+        case 2: // duplicated
+          m.Triangles.push_back(m.Triangles[f]);
+          break;
+        case 3: // a third triangle on one of its edges, to a random point
+          m.Triangles.push_back({ m.Triangles[f][0], m.Triangles[f][1], static_cast<int>(next(nv)) });
+          break;
+        default: // a repeated corner (only in some trials: they take the general path)
+          if (trial % 3 == 0)
+            m.Triangles[f][2] = m.Triangles[f][0];
+          break;
+      }
+    }
+    // brute force: edges
+    std::map<std::pair<int, int>, std::vector<bool>> edges; // (lo, hi) -> runs lo -> hi?
+    for (const Triangle& t : m.Triangles)
+      for (int i = 0; i < 3; ++i)
+      {
+        const int a = t[i], b = t[(i + 1) % 3];
+        edges[{ std::min(a, b), std::max(a, b) }].push_back(a < b);
+      }
+    std::int64_t boundary = 0, nonManifold = 0, inconsistent = 0;
+    for (const auto& e : edges)
+    {
+      if (e.second.size() == 1)
+        ++boundary;
+      else if (e.second.size() > 2)
+        ++nonManifold;
+      else if (e.second[0] == e.second[1])
+        ++inconsistent;
+    }
+    // brute force: fans, by a walk over the triangles at v linked by a shared neighbour of v
+    std::int64_t nonManifoldVertices = 0;
+    for (int v = 0; v < nv; ++v)
+    {
+      std::vector<int> at;
+      for (std::size_t f = 0; f < m.Triangles.size(); ++f)
+        for (int i = 0; i < 3; ++i)
+          if (m.Triangles[f][i] == v)
+            at.push_back(static_cast<int>(f));
+      if (at.empty())
+        continue;
+      auto others = [&](int f) {
+        std::set<int> o;
+        for (int w : m.Triangles[f])
+          if (w != v)
+            o.insert(w);
+        return o;
+      };
+      std::vector<char> seen(at.size(), 0);
+      int fans = 0;
+      for (std::size_t s = 0; s < at.size(); ++s)
+      {
+        if (seen[s])
+          continue;
+        ++fans;
+        std::vector<std::size_t> stack{ s };
+        seen[s] = 1;
+        while (!stack.empty())
+        {
+          const std::size_t a = stack.back();
+          stack.pop_back();
+          const std::set<int> oa = others(at[a]);
+          for (std::size_t b = 0; b < at.size(); ++b)
+          {
+            if (seen[b])
+              continue;
+            const std::set<int> ob = others(at[b]);
+            bool shared = false;
+            for (int w : ob)
+              shared = shared || oa.count(w) > 0;
+            if (shared)
+            {
+              seen[b] = 1;
+              stack.push_back(b);
+            }
+          }
+        }
+      }
+      nonManifoldVertices += fans > 1 ? 1 : 0;
+    }
+    const MeshDefects d = checkTriangleMesh(m);
+    EXPECT_EQ(d.BoundaryEdges, boundary);
+    EXPECT_EQ(d.NonManifoldEdges, nonManifold);
+    EXPECT_EQ(d.InconsistentEdges, inconsistent);
+    EXPECT_EQ(d.NonManifoldVertices, nonManifoldVertices);
+  }
+}
+
+// prepareMesh finds boundary edges (which decide where coincident points merge) and duplicated
+// triangles by grouping at each point (Validation.cxx): on a split-corner torus (every triangle
+// with its own three points, as in an STL file) with random triangles repeated in any corner
+// order, the merge must
+// join every position, and exactly the repeats must be dropped (counted by brute force over
+// position triples), the first of each kept, leaving the closed torus.
+TEST(Validation, MergesAndDuplicatesEqualABruteForceCount)
+{
+  unsigned seed = 11u;
+  auto next = [&seed](unsigned m) {
+    seed = seed * 1664525u + 1013904223u;
+    return (seed >> 8) % m;
+  };
+  for (int trial = 0; trial < 20; ++trial)
+  {
+    SCOPED_TRACE(trial);
+    const TriangleMesh torus =
+      makeTorus(Vec3(0, 0, 0), 1.0, 0.35, 8 + static_cast<int>(next(12)), 5 + static_cast<int>(next(8)));
+    PolygonMesh m;
+    for (const Triangle& t : torus.Triangles)
+    {
+      const std::int64_t base = static_cast<std::int64_t>(m.Points.size());
+      for (int v : t)
+        m.Points.push_back(torus.Points[v]);
+      m.addCell({ base, base + 1, base + 2 });
+    }
+    const std::size_t original = m.numberOfCells();
+    const int repeats = static_cast<int>(next(40));
+    for (int k = 0; k < repeats; ++k)
+    {
+      const std::size_t c = next(static_cast<unsigned>(original));
+      // with points of its own, as in an STL file (repeats sharing their points would leave those
+      // points off the boundary, where coincident points are kept apart on purpose)
+      const std::int64_t b = m.Offsets[c];
+      const std::int64_t base = static_cast<std::int64_t>(m.Points.size());
+      for (int k = 0; k < 3; ++k)
+        m.Points.push_back(Vec3(m.Points[m.Connectivity[b + k]]));
+      std::int64_t ids[3] = { base, base + 1, base + 2 };
+      if (next(2))
+        std::swap(ids[1], ids[2]);              // reversed
+      std::rotate(ids, ids + next(3), ids + 3); // and rotated
+      m.addCell({ ids[0], ids[1], ids[2] });
+    }
+    // brute force: distinct position triples among the cells
+    std::set<std::array<std::array<double, 3>, 3>> distinct;
+    for (std::size_t c = 0; c < m.numberOfCells(); ++c)
+    {
+      std::array<std::array<double, 3>, 3> key;
+      for (int k = 0; k < 3; ++k)
+      {
+        const Vec3& p = m.Points[m.Connectivity[m.Offsets[c] + k]];
+        key[k] = { p.x(), p.y(), p.z() };
+      }
+      std::sort(key.begin(), key.end());
+      distinct.insert(key);
+    }
+    TriangleMesh out;
+    const MeshDefects d = prepareMesh(m, out);
+    EXPECT_EQ(d.DroppedDuplicateTriangles, static_cast<std::int64_t>(m.numberOfCells() - distinct.size()));
+    EXPECT_EQ(out.Triangles.size(), distinct.size());
+    EXPECT_EQ(out.Points.size(), torus.Points.size());
+    EXPECT_EQ(d.BoundaryEdges, 0);
+    EXPECT_EQ(d.NonManifoldEdges, 0);
+    EXPECT_TRUE(d.usable()) << d.errorMessage();
+    EXPECT_EQ(d.Genus, 1);
+    // the first of each repeated triple is the one kept: the torus' own triangles, in order
+    ASSERT_GE(out.Triangles.size(), torus.Triangles.size());
+    for (std::size_t f = 0; f < torus.Triangles.size(); ++f)
+      for (int k = 0; k < 3; ++k)
+        EXPECT_EQ(out.Points[out.Triangles[f][k]], torus.Points[torus.Triangles[f][k]]);
+  }
 }
