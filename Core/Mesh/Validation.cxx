@@ -396,6 +396,19 @@ namespace
 /// Cells, triangles or vertices between two cancel checks of a loop over a whole mesh.
 constexpr std::size_t CheckEvery = std::size_t(1) << 16;
 
+/// One undirected edge by the triangles along it: one is a boundary, more than two make it
+/// non-manifold, two that run it the same way make it inconsistent (`sameWay`: the first two).
+void countEdge(
+  std::size_t count, bool sameWay, std::int64_t& boundary, std::int64_t& nonManifold, std::int64_t& inconsistent)
+{
+  if (count == 1)
+    ++boundary;
+  else if (count > 2)
+    ++nonManifold;
+  else if (sameWay)
+    ++inconsistent;
+}
+
 /// Edge classes by a sort of all half-edges: the general path (triangles with a repeated corner
 /// included). False when `progress` was cancelled.
 bool classifyEdgesBySort(const TriangleMesh& mesh, MeshDefects& d, Progress* progress)
@@ -423,19 +436,8 @@ bool classifyEdgesBySort(const TriangleMesh& mesh, MeshDefects& d, Progress* pro
     {
       ++j;
     }
-    const std::size_t count = j - i;
-    if (count == 1)
-    {
-      ++d.BoundaryEdges;
-    }
-    else if (count > 2)
-    {
-      ++d.NonManifoldEdges;
-    }
-    else if (he[i].Forward == he[i + 1].Forward)
-    {
-      ++d.InconsistentEdges;
-    }
+    countEdge(j - i, j - i == 2 && he[i].Forward == he[i + 1].Forward, d.BoundaryEdges, d.NonManifoldEdges,
+      d.InconsistentEdges);
     i = j;
   }
   return true;
@@ -529,15 +531,8 @@ bool checkTopology(const TriangleMesh& mesh, MeshDefects& d, Progress* progress 
             ++j;
           }
           if (edgesHere && around[i].W > static_cast<int>(v))
-          {
-            const std::size_t count = j - i;
-            if (count == 1)
-              ++c.Boundary;
-            else if (count > 2)
-              ++c.NonManifold;
-            else if (around[i].Out == around[i + 1].Out)
-              ++c.Inconsistent;
-          }
+            countEdge(
+              j - i, j - i == 2 && around[i].Out == around[i + 1].Out, c.Boundary, c.NonManifold, c.Inconsistent);
           i = j;
         }
         int fans = 0;

@@ -452,6 +452,24 @@ TEST(Validation, UnreferencedPointsAndIgnoredCellsAreDropped)
   EXPECT_NEAR(signedVolume(out), 1.0, 1e-12);
 }
 
+namespace
+{
+/// A small deterministic generator for the randomized tests: next(m) is in [0, m).
+struct RandomBelow
+{
+  explicit RandomBelow(unsigned seed)
+    : Seed(seed)
+  {
+  }
+  unsigned operator()(unsigned m)
+  {
+    Seed = Seed * 1664525u + 1013904223u;
+    return (Seed >> 8) % m;
+  }
+  unsigned Seed;
+};
+} // namespace
+
 // checkTriangleMesh classifies each undirected edge around its lower vertex (Validation.cxx): on
 // meshes damaged at random (triangles removed, flipped, duplicated, extra triangles on existing
 // edges, repeated corners) its counts must equal a brute-force count over all edges (a map from
@@ -459,11 +477,7 @@ TEST(Validation, UnreferencedPointsAndIgnoredCellsAreDropped)
 // fans found by walking each vertex's triangles through shared edges.
 TEST(Validation, EdgeAndVertexCountsEqualABruteForceCount)
 {
-  unsigned seed = 7u;
-  auto next = [&seed](unsigned m) {
-    seed = seed * 1664525u + 1013904223u;
-    return (seed >> 8) % m;
-  };
+  RandomBelow next(7u);
   for (int trial = 0; trial < 60; ++trial)
   {
     SCOPED_TRACE(trial);
@@ -572,16 +586,11 @@ TEST(Validation, EdgeAndVertexCountsEqualABruteForceCount)
 // prepareMesh finds boundary edges (which decide where coincident points merge) and duplicated
 // triangles by grouping at each point (Validation.cxx): on a split-corner torus (every triangle
 // with its own three points, as in an STL file) with random triangles repeated in any corner
-// order, the merge must
-// join every position, and exactly the repeats must be dropped (counted by brute force over
-// position triples), the first of each kept, leaving the closed torus.
+// order, the merge must join every position, and exactly the repeats must be dropped (counted
+// by brute force over position triples), the first of each kept, leaving the closed torus.
 TEST(Validation, MergesAndDuplicatesEqualABruteForceCount)
 {
-  unsigned seed = 11u;
-  auto next = [&seed](unsigned m) {
-    seed = seed * 1664525u + 1013904223u;
-    return (seed >> 8) % m;
-  };
+  RandomBelow next(11u);
   for (int trial = 0; trial < 20; ++trial)
   {
     SCOPED_TRACE(trial);
