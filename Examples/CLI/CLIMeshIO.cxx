@@ -3,6 +3,7 @@
 
 #include "CLIMessages.h"
 #include "CLIParsers.h"
+#include "CLIWriters.h"
 
 #include "Common/LargePages.h" // sdfcage::ReserveLarge (Core)
 #include "Mesh/Shapes.h"       // sdfcage::makeBuiltinShape (Core)
@@ -13,14 +14,11 @@
 #include <vtkDoubleArray.h>
 #include <vtkIdTypeArray.h>
 #include <vtkNew.h>
-#include <vtkOBJWriter.h>
 #include <vtkOFFReader.h>
 #include <vtkOFFWriter.h>
-#include <vtkPLYWriter.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkPolyDataWriter.h>
-#include <vtkSTLWriter.h>
 #include <vtkXMLPolyDataReader.h>
 #include <vtkXMLPolyDataWriter.h>
 
@@ -123,6 +121,41 @@ vtkSmartPointer<vtkPolyData> toPolyData(const ParsedMesh& ply)
   mesh->SetPoints(points);
   mesh->SetPolys(polys);
   return mesh;
+}
+
+/// The points and the polygons of `mesh` for the writers of CLIWriters.h (triangle strips as
+/// triangles, alternately turned so that they keep the strip's orientation).
+ParsedMesh fromPolyData(vtkPolyData* mesh)
+{
+  ParsedMesh out;
+  out.Offsets.push_back(0);
+  const vtkIdType np = mesh->GetNumberOfPoints();
+  out.Points.resize(3 * static_cast<std::size_t>(np));
+  for (vtkIdType i = 0; i < np; ++i)
+    mesh->GetPoint(i, &out.Points[3 * static_cast<std::size_t>(i)]);
+  const auto add = [&out](std::initializer_list<vtkIdType> ids) {
+    for (vtkIdType id : ids)
+      out.Connectivity.push_back(static_cast<std::int64_t>(id));
+    out.Offsets.push_back(static_cast<std::int64_t>(out.Connectivity.size()));
+  };
+  vtkIdType n = 0;
+  const vtkIdType* ids = nullptr;
+  if (vtkCellArray* polys = mesh->GetPolys())
+  {
+    for (polys->InitTraversal(); polys->GetNextCell(n, ids);)
+    {
+      for (vtkIdType k = 0; k < n; ++k)
+        out.Connectivity.push_back(static_cast<std::int64_t>(ids[k]));
+      out.Offsets.push_back(static_cast<std::int64_t>(out.Connectivity.size()));
+    }
+  }
+  if (vtkCellArray* strips = mesh->GetStrips())
+  {
+    for (strips->InitTraversal(); strips->GetNextCell(n, ids);)
+      for (vtkIdType k = 0; k + 2 < n; ++k)
+        k % 2 == 0 ? add({ ids[k], ids[k + 1], ids[k + 2] }) : add({ ids[k + 1], ids[k], ids[k + 2] });
+  }
+  return out;
 }
 
 /// VTK XML PolyData: the arrays that are read (the points and the cell arrays; the data arrays
@@ -415,31 +448,13 @@ bool writeMesh(vtkPolyData* mesh, const std::string& path, std::string& error)
     ok = writer->Write();
     errorCode = writer->GetErrorCode();
   }
-  else if (ext == ".obj")
+  else if (ext == ".obj" || ext == ".ply" || ext == ".stl")
   {
-    vtkNew<vtkOBJWriter> writer;
-    writer->SetFileName(path.c_str());
-    writer->SetInputData(mesh);
-    ok = writer->Write();
-    errorCode = writer->GetErrorCode();
-  }
-  else if (ext == ".ply")
-  {
-    vtkNew<vtkPLYWriter> writer;
-    writer->SetFileName(path.c_str());
-    writer->SetFileTypeToBinary();
-    writer->SetInputData(mesh);
-    ok = writer->Write();
-    errorCode = writer->GetErrorCode();
-  }
-  else if (ext == ".stl")
-  {
-    vtkNew<vtkSTLWriter> writer;
-    writer->SetFileName(path.c_str());
-    writer->SetFileTypeToBinary();
-    writer->SetInputData(mesh);
-    ok = writer->Write();
-    errorCode = writer->GetErrorCode();
+    // our own writers (CLIWriters.h says why not VTK's)
+    const ParsedMesh m = fromPolyData(mesh);
+    return ext == ".obj" ? writeOBJ(m, path, error)
+      : ext == ".ply"    ? writePLY(m, path, error)
+                         : writeSTL(m, path, error);
   }
   else if (ext == ".vtp")
   {

@@ -1057,14 +1057,14 @@ int stopCode(const Options& o, RunReport& r, const std::vector<std::string>& fil
   return -1;
 }
 
-/// PLY and STL store coordinates as 32-bit floats. Rounding moves every point of the cage by at
+/// STL stores coordinates as 32-bit floats (PLY is written with doubles). Rounding moves every point of the cage by at
 /// most the largest vertex move, so the verified clearance survives when that move is a small
 /// part of it (at most a tenth); far from the origin (1e12 away, say) it is not: then nothing
 /// is written and the message says which formats keep doubles.
 bool fitsSinglePrecision(vtkPolyData* cage, const std::string& path, double clearance, std::string& error)
 {
   const std::string ext = lowerExtension(path);
-  if (ext != ".ply" && ext != ".stl")
+  if (ext != ".stl")
   {
     return true;
   }
@@ -1083,9 +1083,10 @@ bool fitsSinglePrecision(vtkPolyData* cage, const std::string& path, double clea
   }
   if (!(largest <= 0.1 * clearance))
   {
-    error = "cannot write '" + path + "': single precision (" + ext + " stores 32-bit floats) would move the cage by up to " +
-      shortNumber(largest) + ", more than a tenth of its clearance " + shortNumber(clearance) +
-      " (input far from the origin?): write .vtp, .vtk, .off or .obj, which keep doubles";
+    error = "cannot write '" + path + "': single precision (" + ext +
+      " stores 32-bit floats) would move the cage by up to " + shortNumber(largest) +
+      ", more than a tenth of its clearance " + shortNumber(clearance) +
+      " (input far from the origin?): write .vtp, .vtk, .off, .obj or .ply, which keep doubles";
     return false;
   }
   return true;

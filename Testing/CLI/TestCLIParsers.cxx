@@ -6,6 +6,7 @@
 // merged points and triangles as vtkSTLReader with merging. Both must refuse damaged files with a
 // reason. OBJ: numbers bit for bit as strtod reads them, face corners as before.
 #include "CLIParsers.h"
+#include "CLIWriters.h"
 
 #include <vtkCellArray.h>
 #include <vtkCellData.h>
@@ -14,6 +15,8 @@
 #include <vtkFloatArray.h>
 #include <vtkIntArray.h>
 #include <vtkNew.h>
+#include <vtkOBJReader.h>
+#include <vtkPLYReader.h>
 #include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
@@ -696,4 +699,127 @@ TEST(OBJParser, NumbersAreWhatStrtodReadsAndIndicesWhatStrtollReads)
     EXPECT_FALSE(sdfcage_cli::parseOBJ(b.data(), b.size(), mesh, error)) << b;
     EXPECT_NE(error.find("line "), std::string::npos) << b << ": " << error;
   }
+}
+
+// The program's own OBJ, PLY and STL writers (CLIWriters.h): what they write reads back, with our
+// parsers and with VTK's readers, to the same points (bit for bit for OBJ and PLY, which keep
+// doubles, except through vtkPLYReader, which keeps floats; as 32-bit floats for STL) and the
+// same faces (a quad fanned into two triangles in STL).
+TEST(Writers, WhatIsWrittenReadsBackWithOurParsersAndVTKs)
+{
+  sdfcage_cli::ParsedMesh mesh;
+  unsigned seed = 3u;
+  for (int i = 0; i < 42; ++i)
+  {
+    seed = seed * 1664525u + 1013904223u;
+    mesh.Points.push_back((static_cast<double>(seed) / 4294967296.0 - 0.5) * std::pow(10.0, i % 7 - 3));
+  }
+  mesh.Points.insert(mesh.Points.end(), { 0.1, 1e-300, -0.0, 1.0 / 3.0, 2.0 / 3.0, 123456.789 });
+  const std::int64_t n = static_cast<std::int64_t>(mesh.Points.size() / 3);
+  mesh.Offsets = { 0 };
+  for (std::int64_t f = 0; f + 2 < n; ++f)
+  {
+    mesh.Connectivity.insert(mesh.Connectivity.end(), { f, f + 1, f + 2 });
+    mesh.Offsets.push_back(static_cast<std::int64_t>(mesh.Connectivity.size()));
+  }
+  mesh.Connectivity.insert(mesh.Connectivity.end(), { 0, 1, 2, 3 }); // a quad
+  mesh.Offsets.push_back(static_cast<std::int64_t>(mesh.Connectivity.size()));
+
+  for (const std::string ext : { ".obj", ".ply", ".stl" })
+  {
+    SCOPED_TRACE(ext);
+    const std::string path = "sdfcage_writer_test" + ext;
+    std::string error;
+    const bool written = ext == ".obj" ? sdfcage_cli::writeOBJ(mesh, path, error)
+      : ext == ".ply"                  ? sdfcage_cli::writePLY(mesh, path, error)
+                                       : sdfcage_cli::writeSTL(mesh, path, error);
+    ASSERT_TRUE(written) << error;
+    const std::string bytes = fileBytes(path);
+    sdfcage_cli::ParsedMesh back;
+    const bool parsed = ext == ".obj" ? sdfcage_cli::parseOBJ(bytes.data(), bytes.size(), back, error)
+      : ext == ".ply"                 ? sdfcage_cli::parsePLY(bytes.data(), bytes.size(), back, error)
+                                      : sdfcage_cli::parseSTL(bytes.data(), bytes.size(), back, error);
+    ASSERT_TRUE(parsed) << error;
+    vtkSmartPointer<vtkPolyData> theirs;
+    if (ext == ".obj")
+    {
+      vtkNew<vtkOBJReader> reader;
+      reader->SetFileName(path.c_str());
+      reader->Update();
+      theirs = reader->GetOutput();
+    }
+    else if (ext == ".ply")
+    {
+      vtkNew<vtkPLYReader> reader;
+      reader->SetFileName(path.c_str());
+      reader->Update();
+      theirs = reader->GetOutput();
+    }
+    else
+    {
+      vtkNew<vtkSTLReader> reader;
+      reader->SetFileName(path.c_str());
+      reader->MergingOff();
+      reader->Update();
+      theirs = reader->GetOutput();
+    }
+    if (ext != ".stl")
+    {
+      // the same points (bit for bit) and faces, read by us and by VTK
+      EXPECT_EQ(back.Points, mesh.Points);
+      EXPECT_EQ(back.Offsets, mesh.Offsets);
+      EXPECT_EQ(back.Connectivity, mesh.Connectivity);
+      ASSERT_EQ(theirs->GetNumberOfPoints(), n);
+      ASSERT_EQ(theirs->GetNumberOfPolys(), static_cast<vtkIdType>(mesh.Offsets.size() - 1));
+      for (vtkIdType i = 0; i < n; ++i)
+      {
+        double p[3];
+        theirs->GetPoint(i, p);
+        for (int k = 0; k < 3; ++k)
+        {
+          const double expected = mesh.Points[3 * static_cast<std::size_t>(i) + static_cast<std::size_t>(k)];
+          // (vtkPLYReader keeps floats whatever the file holds)
+          EXPECT_EQ(p[k], ext == ".ply" ? static_cast<double>(static_cast<float>(expected)) : expected) << i;
+        }
+      }
+    }
+    else
+    {
+      // each face fanned into triangles, every corner a 32-bit float of the point
+      const std::size_t triangles = mesh.Offsets.size() - 2 + 2;
+      ASSERT_EQ(back.Offsets.size(), triangles + 1);
+      ASSERT_EQ(theirs->GetNumberOfPolys(), static_cast<vtkIdType>(triangles));
+      std::size_t t = 0;
+      for (std::size_t f = 0; f + 1 < mesh.Offsets.size(); ++f)
+        for (std::int64_t k = mesh.Offsets[f] + 1; k + 1 < mesh.Offsets[f + 1]; ++k, ++t)
+        {
+          const std::int64_t corners[3] = { mesh.Connectivity[static_cast<std::size_t>(mesh.Offsets[f])],
+            mesh.Connectivity[static_cast<std::size_t>(k)], mesh.Connectivity[static_cast<std::size_t>(k + 1)] };
+          vtkIdType npts = 0;
+          const vtkIdType* ids = nullptr;
+          theirs->GetPolys()->GetCellAtId(static_cast<vtkIdType>(t), npts, ids);
+          ASSERT_EQ(npts, 3);
+          for (int c = 0; c < 3; ++c)
+          {
+            double p[3];
+            theirs->GetPoint(ids[c], p);
+            const double* q =
+              &back.Points[3 * static_cast<std::size_t>(back.Connectivity[3 * t + static_cast<std::size_t>(c)])];
+            for (int a = 0; a < 3; ++a)
+            {
+              const float expected =
+                static_cast<float>(mesh.Points[3 * static_cast<std::size_t>(corners[c]) + static_cast<std::size_t>(a)]);
+              EXPECT_EQ(p[a], static_cast<double>(expected));
+              EXPECT_EQ(q[a], static_cast<double>(expected));
+            }
+          }
+        }
+    }
+  }
+  // an unwritable path: false with a reason naming it, no crash
+  std::string error;
+  EXPECT_FALSE(sdfcage_cli::writeOBJ(mesh, "no/such/folder/x.obj", error));
+  EXPECT_NE(error.find("no/such/folder/x.obj"), std::string::npos) << error;
+  EXPECT_FALSE(sdfcage_cli::writePLY(mesh, "no/such/folder/x.ply", error));
+  EXPECT_FALSE(sdfcage_cli::writeSTL(mesh, "no/such/folder/x.stl", error));
 }
