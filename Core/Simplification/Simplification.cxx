@@ -8,6 +8,7 @@
 #include "Spatial/TriangleTree.h"
 
 #include <algorithm>
+#include <iterator>
 #include <chrono>
 #include <cmath>
 #include <cstdint>
@@ -284,10 +285,10 @@ public:
   void drain(int target, int start, SimplifyResult& r)
   {
     std::vector<Eval> batch(BatchSize);
-    std::vector<Entry> aside;
+    std::vector<Entry> aside, held;
     std::vector<std::pair<Vec3, Vec3>> formBoxes, writeBoxes;
     const double margin = std::max(Opt.selfClearance(), PartRoom);
-    while (AliveVertices > target && !Heap.empty())
+    while (AliveVertices > target && (!Heap.empty() || !held.empty()))
     {
       // progress every 16 batches; a cancel check every batch (a batch is some 10 ms, 16 of them
       // made a cancel wait up to 0.3 s on a loaded machine)
@@ -305,14 +306,25 @@ public:
         r.Cancelled = true;
         break;
       }
-      // form: valid entries in queue order, skipping (for the next batch) those next to a member
+      // form: valid entries in queue order, skipping (for the next batch) those next to a member.
+      // The entries skipped by the previous batch (`held`, in queue order) are merged with the
+      // queue rather than pushed back into it: the same order, without a push and a pop per
+      // skipped entry (where the cheapest edges lie together, e.g. the equal-cost edges of a
+      // uniform envelope's flat faces, most batches skip 2 x BatchSize of them)
       int n = 0;
       aside.clear();
       formBoxes.clear();
-      while (n < BatchSize && !Heap.empty() && aside.size() < 2 * BatchSize)
+      std::size_t nextHeld = 0;
+      while (n < BatchSize && (nextHeld < held.size() || !Heap.empty()) && aside.size() < 2 * BatchSize)
       {
-        const Entry e = Heap.top();
-        Heap.pop();
+        Entry e;
+        if (nextHeld < held.size() && (Heap.empty() || !(held[nextHeld] < Heap.top())))
+          e = held[nextHeld++];
+        else
+        {
+          e = Heap.top();
+          Heap.pop();
+        }
         if (!VAlive[e.V0] || !VAlive[e.V1] || Ver[e.V0] != e.Ver0 || Ver[e.V1] != e.Ver1)
           continue;
         Vec3 lo = e.Pos, hi = e.Pos;
@@ -336,8 +348,15 @@ public:
         formBoxes.emplace_back(lo, hi);
         batch[n++].E = e;
       }
-      for (const Entry& e : aside)
-        Heap.push(e);
+      // what this batch skipped comes first next time, then what the previous one skipped and
+      // this one did not reach (both in queue order, and none after the other: merged)
+      {
+        std::vector<Entry> next;
+        next.reserve(aside.size() + held.size() - nextHeld);
+        std::merge(aside.begin(), aside.end(), held.begin() + static_cast<std::ptrdiff_t>(nextHeld), held.end(),
+          std::back_inserter(next), [](const Entry& a, const Entry& b) { return b < a; });
+        held.swap(next);
+      }
       if (n == 0)
         continue;
 
@@ -378,7 +397,12 @@ public:
         if (ev.Relocated)
         {
           ++Stats.Relocated;
-          if (!Heap.empty() && ev.Cost > Heap.top().Cost)
+          // (the queue's cheapest: its top or the first entry held back)
+          const bool queued = !Heap.empty() || !held.empty();
+          const double cheapest = Heap.empty() ? held.front().Cost
+            : held.empty()                     ? Heap.top().Cost
+                                               : std::min(Heap.top().Cost, held.front().Cost);
+          if (queued && ev.Cost > cheapest)
           {
             // no longer the cheapest: queue it with its feasible placement
             Heap.push({ ev.Cost, ev.C0, ev.C1, Ver[ev.C0], Ver[ev.C1], ev.Pos });
@@ -400,6 +424,9 @@ public:
           rebuildGrid();
       }
     }
+    // (a later pass or drain finds them in the queue, as before)
+    for (const Entry& e : held)
+      Heap.push(e);
   }
 
   // Did a collapse applied earlier in this batch change what `ev` read?
