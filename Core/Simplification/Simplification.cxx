@@ -398,11 +398,12 @@ public:
         {
           ++Stats.Relocated;
           // (the queue's cheapest: its top or the first entry held back)
-          const bool queued = !Heap.empty() || !held.empty();
-          const double cheapest = Heap.empty() ? held.front().Cost
-            : held.empty()                     ? Heap.top().Cost
-                                               : std::min(Heap.top().Cost, held.front().Cost);
-          if (queued && ev.Cost > cheapest)
+          double cheapest = std::numeric_limits<double>::infinity();
+          if (!Heap.empty())
+            cheapest = Heap.top().Cost;
+          if (!held.empty())
+            cheapest = std::min(cheapest, held.front().Cost);
+          if (ev.Cost > cheapest)
           {
             // no longer the cheapest: queue it with its feasible placement
             Heap.push({ ev.Cost, ev.C0, ev.C1, Ver[ev.C0], Ver[ev.C1], ev.Pos });
