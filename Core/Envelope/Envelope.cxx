@@ -377,14 +377,24 @@ std::size_t projectOntoAmplifiedOffset(
     }
     if (round > 0)
     {
-      // the boxes of the triangles a restoration changed, in a grid of their own
+      // the boxes of the triangles a restoration changed, in a grid of their own (a small mesh
+      // of just their corners, renumbered)
       TriangleMesh changed;
-      changed.Points = envelope.Points;
+      std::unordered_map<int, int> compact;
       for (std::size_t f = 0; f < nf; ++f)
       {
         const Triangle& t = envelope.Triangles[f];
-        if (restoredPoint[t[0]] || restoredPoint[t[1]] || restoredPoint[t[2]])
-          changed.Triangles.push_back(t);
+        if (!(restoredPoint[t[0]] || restoredPoint[t[1]] || restoredPoint[t[2]]))
+          continue;
+        Triangle c;
+        for (int k = 0; k < 3; ++k)
+        {
+          const auto it = compact.emplace(t[k], static_cast<int>(changed.Points.size())).first;
+          if (it->second == static_cast<int>(changed.Points.size()))
+            changed.Points.push_back(envelope.Points[t[k]]);
+          c[k] = it->second;
+        }
+        changed.Triangles.push_back(c);
       }
       TriangleIndex near;
       near.build(changed);

@@ -285,7 +285,7 @@ public:
   void drain(int target, int start, SimplifyResult& r)
   {
     std::vector<Eval> batch(BatchSize);
-    std::vector<Entry> aside, held;
+    std::vector<Entry> aside, held, merged; // merged: the next `held`, a buffer kept across batches
     std::vector<std::pair<Vec3, Vec3>> formBoxes, writeBoxes;
     const double margin = std::max(Opt.selfClearance(), PartRoom);
     while (AliveVertices > target && (!Heap.empty() || !held.empty()))
@@ -350,13 +350,10 @@ public:
       }
       // what this batch skipped comes first next time, then what the previous one skipped and
       // this one did not reach (both in queue order, and none after the other: merged)
-      {
-        std::vector<Entry> next;
-        next.reserve(aside.size() + held.size() - nextHeld);
-        std::merge(aside.begin(), aside.end(), held.begin() + static_cast<std::ptrdiff_t>(nextHeld), held.end(),
-          std::back_inserter(next), [](const Entry& a, const Entry& b) { return b < a; });
-        held.swap(next);
-      }
+      merged.clear();
+      std::merge(aside.begin(), aside.end(), held.begin() + static_cast<std::ptrdiff_t>(nextHeld), held.end(),
+        std::back_inserter(merged), [](const Entry& a, const Entry& b) { return b < a; });
+      held.swap(merged);
       if (n == 0)
         continue;
 
