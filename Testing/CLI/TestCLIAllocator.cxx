@@ -1,0 +1,105 @@
+// SDFCage — tests of the sdfcage program's allocator tuning (Examples/CLI/CLIAllocator.cxx): it
+// sets the thresholds, reserves a heap range advised for transparent huge pages that serves the
+// following allocations, keeps freed memory, and leaves a user's own settings alone. Each test runs
+// in a process of its own (gtest_discover_tests), as the program calls it once at its start.
+#include "CLIAllocator.h"
+
+#include <gtest/gtest.h>
+
+#include <sys/resource.h>
+
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <fstream>
+#include <string>
+#include <vector>
+
+extern char** environ;
+
+namespace
+{
+
+void clearAllocatorEnvironment()
+{
+  std::vector<std::string> names;
+  for (char** e = environ; e && *e; ++e)
+    if (std::strncmp(*e, "GLIBC_TUNABLES=", 15) == 0 || std::strncmp(*e, "MALLOC_", 7) == 0)
+      names.emplace_back(*e, std::strchr(*e, '=') - *e);
+  for (const std::string& n : names)
+    unsetenv(n.c_str());
+}
+
+long minorFaults()
+{
+  rusage u{};
+  getrusage(RUSAGE_SELF, &u);
+  return u.ru_minflt;
+}
+
+// "always" or "madvise" selected in the kernel's setting
+bool hugePagesOnAdvice()
+{
+  std::ifstream f("/sys/kernel/mm/transparent_hugepage/enabled");
+  std::string s;
+  std::getline(f, s);
+  return s.find("[always]") != std::string::npos || s.find("[madvise]") != std::string::npos;
+}
+
+// touches every 4 KB page of a fresh block and returns the page faults that took
+long faultsTouching(std::size_t bytes, std::uintptr_t* where = nullptr)
+{
+  char* p = static_cast<char*>(std::malloc(bytes));
+  if (where)
+    *where = reinterpret_cast<std::uintptr_t>(p);
+  const long before = minorFaults();
+  for (std::size_t i = 0; i < bytes; i += 4096)
+    p[i] = static_cast<char>(i);
+  const long faults = minorFaults() - before;
+  volatile char keep = p[bytes / 2];
+  (void)keep;
+  std::free(p);
+  return faults;
+}
+
+} // namespace
+
+#if defined(__GLIBC__) && defined(__linux__)
+
+TEST(CLIAllocator, ReservesAHugePageHeapThatServesLaterBlocks)
+{
+  clearAllocatorEnvironment();
+  const sdfcage_cli::AllocatorTuning t = sdfcage_cli::tuneAllocator();
+  EXPECT_FALSE(t.Skipped);
+  ASSERT_TRUE(t.Tuned);
+  constexpr std::size_t MB = std::size_t(1) << 20;
+  // the reservation: 30-MB blocks up to 512 MB (or an eighth of the memory) and the heap's
+  // 64-MB pad, from the heap
+  EXPECT_GE(t.AdvisedBytes, 28 * MB);
+  EXPECT_LE(t.AdvisedBytes, (512 + 64) * MB);
+  // a 16-MB block (below the 32-MB mmap threshold) comes from that heap: 4,096 pages of 4 KB
+  // fault once per 2 MB where huge pages are given on advice (a few more at the block's ends)
+  const long faults = faultsTouching(16 * MB);
+  if (hugePagesOnAdvice())
+    EXPECT_LT(faults, 256) << "16 MB touched with " << faults << " page faults";
+  else
+    EXPECT_GT(faults, 0);
+  // freed memory stays in the heap: the same block again faults no more
+  const long again = faultsTouching(16 * MB);
+  EXPECT_LT(again, 64) << "16 MB touched again with " << again << " page faults";
+}
+
+TEST(CLIAllocator, LeavesTheUsersSettingsAlone)
+{
+  clearAllocatorEnvironment();
+  setenv("MALLOC_ARENA_MAX", "4", 1);
+  const sdfcage_cli::AllocatorTuning t = sdfcage_cli::tuneAllocator();
+  EXPECT_TRUE(t.Skipped);
+  EXPECT_FALSE(t.Tuned);
+  EXPECT_EQ(t.AdvisedBytes, 0u);
+  unsetenv("MALLOC_ARENA_MAX");
+  setenv("GLIBC_TUNABLES", "glibc.malloc.hugetlb=1", 1);
+  EXPECT_TRUE(sdfcage_cli::tuneAllocator().Skipped);
+}
+
+#endif
