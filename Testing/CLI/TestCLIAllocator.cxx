@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -46,16 +47,39 @@ bool hugePagesOnAdvice()
   return s.find("[always]") != std::string::npos || s.find("[madvise]") != std::string::npos;
 }
 
-// touches every 4 KB page of a fresh block and returns the page faults that took
-long faultsTouching(std::size_t bytes, std::uintptr_t* where = nullptr)
+// the VmFlags of the mapping that holds address a (/proc/self/smaps), empty if none does
+std::string mappingFlags(std::uintptr_t a)
+{
+  std::ifstream f("/proc/self/smaps");
+  std::string line;
+  bool inside = false;
+  while (std::getline(f, line))
+  {
+    unsigned long lo = 0, hi = 0;
+    char dash = 0;
+    std::istringstream head(line);
+    if (head >> std::hex >> lo >> dash >> hi && dash == '-')
+    {
+      inside = lo <= a && a < hi;
+      continue;
+    }
+    if (inside && line.rfind("VmFlags:", 0) == 0)
+      return line;
+  }
+  return std::string();
+}
+
+// touches every 4 KB page of a fresh block and returns the page faults that took; `flags`: the
+// VmFlags of the mapping the block lies in
+long faultsTouching(std::size_t bytes, std::string* flags = nullptr)
 {
   char* p = static_cast<char*>(std::malloc(bytes));
-  if (where)
-    *where = reinterpret_cast<std::uintptr_t>(p);
   const long before = minorFaults();
   for (std::size_t i = 0; i < bytes; i += 4096)
     p[i] = static_cast<char>(i);
   const long faults = minorFaults() - before;
+  if (flags)
+    *flags = mappingFlags(reinterpret_cast<std::uintptr_t>(p) + bytes / 2);
   volatile char keep = p[bytes / 2];
   (void)keep;
   std::free(p);
@@ -77,13 +101,16 @@ TEST(CLIAllocator, ReservesAHugePageHeapThatServesLaterBlocks)
   // 64-MB pad, from the heap
   EXPECT_GE(t.AdvisedBytes, 28 * MB);
   EXPECT_LE(t.AdvisedBytes, (512 + 64) * MB);
-  // a 16-MB block (below the 32-MB mmap threshold) comes from that heap: 4,096 pages of 4 KB
-  // fault once per 2 MB where huge pages are given on advice (a few more at the block's ends)
-  const long faults = faultsTouching(16 * MB);
+  // a 16-MB block (below the 32-MB mmap threshold) comes from that heap, a mapping advised for
+  // huge pages ("hg"); its 4,096 pages of 4 KB fault about once per 2 MB where the kernel gives
+  // huge pages on advice. (Not always all 8: with other processes' memory in the way the kernel
+  // falls back to 4-KB pages for some; 315-446 faults were seen with the test suite running
+  // beside it. At least half of them huge is asked.)
+  std::string flags;
+  const long faults = faultsTouching(16 * MB, &flags);
+  EXPECT_NE(flags.find(" hg"), std::string::npos) << "the block's mapping: " << flags;
   if (hugePagesOnAdvice())
-    EXPECT_LT(faults, 256) << "16 MB touched with " << faults << " page faults";
-  else
-    EXPECT_GT(faults, 0);
+    EXPECT_LT(faults, 2048) << "16 MB touched with " << faults << " page faults";
   // freed memory stays in the heap: the same block again faults no more
   const long again = faultsTouching(16 * MB);
   EXPECT_LT(again, 64) << "16 MB touched again with " << again << " page faults";
