@@ -304,7 +304,9 @@ inline void TriangleTree::prefetch(const Ref& r) const
 #if defined(__GNUC__)
   if (r.Count == 0)
   {
-    __builtin_prefetch(&QueryNodes[static_cast<std::size_t>(r.Child)]);
+    const char* node = reinterpret_cast<const char*>(&QueryNodes[static_cast<std::size_t>(r.Child)]);
+    __builtin_prefetch(node);
+    __builtin_prefetch(node + 64);
   }
   else
   {
@@ -335,6 +337,61 @@ void TriangleTree::buildQueryNodes()
     return n.Left >= 0 ? Ref{ queryIndex[node], 0 } : Ref{ n.Start, n.Count };
   };
   Root = Nodes.empty() ? Ref{ 0, 0 } : ref(0);
+  // each node's entries in Tri (pre-order: a subtree's leaves are one range, children after
+  // their parent), for the slabs
+  std::vector<int> first(Nodes.size()), count(Nodes.size());
+  double scale = 0.0;
+  for (std::size_t i = Nodes.size(); i-- > 0;)
+  {
+    const Node& n = Nodes[i];
+    first[i] = n.Left >= 0 ? first[static_cast<std::size_t>(n.Left)] : n.Start;
+    count[i] =
+      n.Left >= 0 ? count[static_cast<std::size_t>(n.Left)] + count[static_cast<std::size_t>(n.Right)] : n.Count;
+  }
+  if (!Nodes.empty())
+  {
+    scale = Nodes[0].Lo.cwiseAbs().cwiseMax(Nodes[0].Hi.cwiseAbs()).maxCoeff();
+  }
+  // a dot product of a direction of norm <= 1 with coordinates up to `scale` rounds by less than
+  // 3 ulp of `scale` (in doubles); the margin is far above that
+  SlabMargin = 1e-13 * scale;
+  // Slabs for subtrees of at most this many entries: larger ones span curved surface, where the
+  // slab is no thinner than the box (and making them would visit each entry at every level).
+  constexpr int SlabEntries = 4096;
+  auto makeSlab = [&](int node, QueryNode& q, int c) {
+    const float inf = std::numeric_limits<float>::infinity();
+    q.Normal[c][0] = q.Normal[c][1] = q.Normal[c][2] = 0.0f;
+    q.SlabLo[c] = -inf;
+    q.SlabHi[c] = inf;
+    const int n = count[static_cast<std::size_t>(node)];
+    if (n > SlabEntries)
+      return;
+    const int begin = first[static_cast<std::size_t>(node)];
+    Vec3 sum = Vec3::Zero();
+    for (int i = begin; i < begin + n; ++i)
+    {
+      const Vec3* P = Tri[static_cast<std::size_t>(i)].P;
+      sum += (P[1] - P[0]).cross(P[2] - P[0]);
+    }
+    const double len = sum.norm();
+    if (!(len > 0.0) || !std::isfinite(len))
+      return;
+    // shortened a little so that the float direction's norm stays below 1: a range gap along it
+    // is then a lower bound of the distance
+    const Vec3 m = sum * ((1.0 - 1e-6) / len);
+    for (int a = 0; a < 3; ++a)
+      q.Normal[c][a] = static_cast<float>(m[a]);
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (int i = begin; i < begin + n; ++i)
+      for (const Vec3& p : Tri[static_cast<std::size_t>(i)].P)
+      {
+        const double v = along(q, c, p);
+        lo = std::min(lo, v);
+        hi = std::max(hi, v);
+      }
+    q.SlabLo[c] = roundDown(lo);
+    q.SlabHi[c] = roundUp(hi);
+  };
   tbb::parallel_for(
     tbb::blocked_range<std::size_t>(0, Nodes.size(), 4096), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t i = r.begin(); i != r.end(); ++i)
@@ -355,6 +412,7 @@ void TriangleTree::buildQueryNodes()
           const Ref r2 = ref(children[c]);
           q.Child[c] = r2.Child;
           q.Count[c] = r2.Count;
+          makeSlab(children[c], q, c);
         }
       }
     });
@@ -493,7 +551,15 @@ bool TriangleTree::closestPoint(const Vec3& p, double maxDistance, Vec3& closest
     const QueryNode& n = QueryNodes[static_cast<std::size_t>(e.R.Child)];
     const double dl = boxPointDistance2(childLo(n, 0), childHi(n, 0), p);
     const double dr = boxPointDistance2(childLo(n, 1), childHi(n, 1), p);
-    const Pending left{ { n.Child[0], n.Count[0] }, dl }, right{ { n.Child[1], n.Count[1] }, dr };
+    // the order is the boxes' (as without slabs, so that ties between equally near triangles
+    // resolve the same); a slab only prunes
+    auto slab2 = [&](int c) {
+      const double a = along(n, c, p);
+      const double g = slabGap(n, c, a, a);
+      return g > 0 ? g * g : 0.0;
+    };
+    const Pending left{ { n.Child[0], n.Count[0] }, std::max(dl, slab2(0)) },
+      right{ { n.Child[1], n.Count[1] }, std::max(dr, slab2(1)) };
     for (const Pending& q : { dl < dr ? right : left, dl < dr ? left : right })
       if (q.D2 <= best2)
       {
@@ -676,7 +742,12 @@ double TriangleTree::triangleQuery(const Vec3 t[3], double limit, bool stopAtFir
         const double box2 = boxBoxDistance2(lo, hi, tlo, thi);
         if (box2 >= best * best)
           continue;
-        const double gap = planeGap(lo, hi);
+        double gap = planeGap(lo, hi);
+        if (gap < best)
+        {
+          const double a0 = along(n, c, t[0]), a1 = along(n, c, t[1]), a2 = along(n, c, t[2]);
+          gap = std::max(gap, slabGap(n, c, std::min({ a0, a1, a2 }), std::max({ a0, a1, a2 })));
+        }
         if (gap < best)
         {
           stack[top++] = { { n.Child[c], n.Count[c] }, box2, gap };

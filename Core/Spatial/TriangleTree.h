@@ -5,6 +5,7 @@
 
 #include "Mesh/Mesh.h"
 
+#include <algorithm>
 #include <vector>
 
 namespace sdfcage
@@ -118,12 +119,24 @@ private:
   // Measured with sdfcage_simplify_benchmark (best of 4) on dragon_vrip.ply, whose 871k-face tree
   // outgrows the caches: the simplification 4.63 -> 4.23 s. A child is an internal node (Count 0:
   // Child is its index here) or a leaf (Child its first entry in Tri, Count its entries).
+  //
+  // Each child also has a slab: a unit direction (its triangles' mean normal) and the range its
+  // triangles' corners span along it. Nothing in the child is nearer to a point or triangle than
+  // the gap between their ranges along it. Where the surface is smooth, the slab is much thinner
+  // than the box, and a query that passes above the surface (the cage's triangles, at the
+  // isovalue from the input) is cleared high in the tree instead of at the leaves. Measured on
+  // armadillo's cage (session 48): the clearance queries opened 37 nodes each instead of 55 and
+  // tested 13 triangles instead of 28; the simplification went 0.51 -> 0.45 s, whole runs of
+  // armadillo_midsub4x 2.18 -> 1.84 s and dragon_vrip 10.1 -> 8.9 s, with the same cages.
   struct alignas(64) QueryNode
   {
     float Lo[2][3];
     float Hi[2][3];
     int Child[2];
     int Count[2];
+    float Normal[2][3]; // |Normal| <= 1; zero (and the range infinite) where no slab was made
+    float SlabLo[2];
+    float SlabHi[2];
   };
   struct Ref
   {
@@ -134,8 +147,20 @@ private:
   void prefetch(const Ref& r) const;
   Vec3 childLo(const QueryNode& q, int c) const { return Vec3(q.Lo[c][0], q.Lo[c][1], q.Lo[c][2]); }
   Vec3 childHi(const QueryNode& q, int c) const { return Vec3(q.Hi[c][0], q.Hi[c][1], q.Hi[c][2]); }
+  // Lower bound of the distance from the points a..b (their range along the child's slab
+  // direction being [lo, hi]) to the child's triangles; <= 0 when the slab does not separate them.
+  double slabGap(const QueryNode& q, int c, double lo, double hi) const
+  {
+    return std::max(static_cast<double>(q.SlabLo[c]) - hi, lo - static_cast<double>(q.SlabHi[c])) - SlabMargin;
+  }
+  double along(const QueryNode& q, int c, const Vec3& p) const
+  {
+    return static_cast<double>(q.Normal[c][0]) * p.x() + static_cast<double>(q.Normal[c][1]) * p.y() +
+      static_cast<double>(q.Normal[c][2]) * p.z();
+  }
   std::vector<Node> Nodes;
   std::vector<QueryNode> QueryNodes;
+  double SlabMargin = 0.0; // rounding of the dot products along a slab direction (coordinates' scale)
   Ref Root{ 0, 0 }; // the root as a child reference (a leaf when the tree has one node)
   std::vector<Dipole> Dipoles;
   std::vector<Tri3> Tri;

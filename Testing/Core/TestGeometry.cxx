@@ -6,6 +6,7 @@
 #include "Mesh/Normalization.h"
 #include "Mesh/Shapes.h"
 #include "Spatial/TriangleIndex.h"
+#include "Spatial/TriangleTree.h"
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
@@ -419,6 +420,117 @@ TEST(TriangleIndex, TriangleDistanceMatchesBruteForce)
       EXPECT_EQ(d, limit) << "query " << q;
     }
   }
+}
+
+TEST(TriangleTree, SlabsPruneOnlyWhatIsNotNearer)
+{
+  // The tree's slabs (each subtree's triangles between two planes along their mean normal) prune
+  // where a query passes just above a smooth surface, the case the cage's clearance checks are.
+  // Queries there, at distances on both sides of the limit, must get exactly the brute-force
+  // answers: distances, "any closer", the triangles within, the closest point.
+  TriangleMesh m = makeSphere(Vec3(0, 0, 0), 1.0, 160, 80);
+  appendMesh(m, makeTorus(Vec3(0, 0, 0), 1.6, 0.25, 96, 24));
+  // a gently curved sheet far from both, with some long slivers across it
+  const int n = 40;
+  const int base = static_cast<int>(m.Points.size());
+  for (int i = 0; i <= n; ++i)
+    for (int j = 0; j <= n; ++j)
+    {
+      const double x = 3.0 + 2.0 * i / n, y = -1.0 + 2.0 * j / n;
+      m.Points.emplace_back(x, y, 0.05 * std::sin(2.0 * x) * std::cos(3.0 * y));
+    }
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+    {
+      const int a = base + i * (n + 1) + j;
+      m.Triangles.push_back({ a, a + n + 1, a + 1 });
+      m.Triangles.push_back({ a + 1, a + n + 1, a + n + 2 });
+    }
+  for (int k = 0; k < 10; ++k)
+    m.Triangles.push_back({ base + k, base + n * (n + 1) + 3 * k, base + k + 1 });
+  TriangleTree whole(m), pieces;
+  ASSERT_TRUE(pieces.build(m, nullptr, true));
+  ASSERT_GT(pieces.splitTriangles(), 0u);
+
+  std::mt19937 rng(37);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  int nearer = 0, farther = 0;
+  for (int q = 0; q < 400; ++q)
+  {
+    // a point on one of the surfaces and its outward normal (numerically, from the tree)
+    Vec3 on, normal;
+    const int which = q % 3;
+    const double a = 2.0 * M_PI * u(rng), b = M_PI * (u(rng) - 0.5);
+    if (which == 0)
+    {
+      on = Vec3(std::cos(a) * std::cos(b), std::sin(a) * std::cos(b), std::sin(b));
+      normal = on;
+    }
+    else if (which == 1)
+    {
+      const Vec3 ring(1.6 * std::cos(a), 1.6 * std::sin(a), 0.0);
+      normal = Vec3(std::cos(a) * std::cos(2 * b), std::sin(a) * std::cos(2 * b), std::sin(2 * b));
+      on = ring + 0.25 * normal;
+    }
+    else
+    {
+      on = Vec3(3.2 + 1.6 * u(rng), -0.8 + 1.6 * u(rng), 0.0);
+      on.z() = 0.05 * std::sin(2.0 * on.x()) * std::cos(3.0 * on.y());
+      normal = Vec3(0, 0, 1);
+    }
+    const double limit = 0.004 + 0.02 * u(rng);
+    const double height = limit * (0.3 + 1.4 * u(rng)); // half below the limit, half above
+    const Vec3 c = on + height * normal;
+    // a triangle about the surface's tangent plane, from small to wide
+    const Vec3 e1 = normal.unitOrthogonal(), e2 = normal.cross(e1);
+    const double size = 0.01 + 0.15 * u(rng);
+    Vec3 t[3];
+    for (int k = 0; k < 3; ++k)
+    {
+      const double phi = a + 2.1 * k + 0.3 * u(rng);
+      t[k] = c + size * (std::cos(phi) * e1 + std::sin(phi) * e2) + 0.1 * size * (u(rng) - 0.5) * normal;
+    }
+    double brute = std::numeric_limits<double>::infinity();
+    std::vector<int> within;
+    for (std::size_t f = 0; f < m.Triangles.size(); ++f)
+    {
+      const Triangle& tri = m.Triangles[f];
+      const Vec3 o[3] = { m.Points[tri[0]], m.Points[tri[1]], m.Points[tri[2]] };
+      const double d = std::sqrt(triangleTriangleDistance2(t, o));
+      brute = std::min(brute, d);
+      if (d < limit)
+        within.push_back(static_cast<int>(f));
+    }
+    (brute < limit ? nearer : farther) += 1;
+    for (const TriangleTree* tree : { &whole, &pieces })
+    {
+      EXPECT_EQ(tree->triangleDistance(t, limit), std::min(brute, limit)) << "query " << q;
+      EXPECT_EQ(tree->anyCloserThan(t, limit), brute < limit) << "query " << q;
+      std::vector<int> got;
+      tree->trianglesWithin(t, limit, got);
+      std::sort(got.begin(), got.end());
+      EXPECT_EQ(got, within) << "query " << q;
+      // a point query from each corner
+      for (const Vec3& p : t)
+      {
+        int bruteTriangle = -1;
+        const double expected = bruteDistance(m, p, bruteTriangle);
+        Vec3 closest;
+        int triangle = -1;
+        double d = -1;
+        const bool found = tree->closestPoint(p, limit, closest, triangle, d);
+        EXPECT_EQ(found, expected <= limit) << "query " << q;
+        if (found)
+        {
+          EXPECT_EQ(d, expected) << "query " << q;
+        }
+        EXPECT_EQ(tree->distance(p), expected) << "query " << q;
+      }
+    }
+  }
+  // both sides of the limit are exercised
+  EXPECT_GT(nearer, 60);
+  EXPECT_GT(farther, 60);
 }
 
 TEST(Geometry, CloserThanAgreesWithTheDistance)
