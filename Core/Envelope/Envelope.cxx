@@ -40,21 +40,6 @@ double seconds(std::chrono::steady_clock::time_point t0)
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
-TriangleMesh keepTriangles(const TriangleMesh& mesh, const std::vector<char>& keep)
-{
-  TriangleMesh out;
-  out.Points = mesh.Points;
-  for (std::size_t f = 0; f < mesh.Triangles.size(); ++f)
-  {
-    if (keep[f])
-    {
-      out.Triangles.push_back(mesh.Triangles[f]);
-    }
-  }
-  removeUnreferencedPoints(out);
-  return out;
-}
-
 /// Keeps the outer boundary: components with negative volume bound trapped air pockets (they face
 /// into the pocket), and positive components nested inside another one are redundant.
 TriangleMesh outerBoundary(const TriangleMesh& surface, int& removed)
@@ -136,7 +121,7 @@ TriangleMesh outerBoundary(const TriangleMesh& surface, int& removed)
   {
     keep[f] = keepComponent[comp[f]];
   }
-  return keepTriangles(surface, keep);
+  return submesh(surface, keep);
 }
 
 /// Flags every triangle of `surface` that crosses another one (beyond shared vertices/edges);
@@ -379,23 +364,13 @@ std::size_t projectOntoAmplifiedOffset(
     {
       // the boxes of the triangles a restoration changed, in a grid of their own (a small mesh
       // of just their corners, renumbered)
-      TriangleMesh changed;
-      std::unordered_map<int, int> compact;
+      std::vector<char> changedTriangle(nf, 0);
       for (std::size_t f = 0; f < nf; ++f)
       {
         const Triangle& t = envelope.Triangles[f];
-        if (!(restoredPoint[t[0]] || restoredPoint[t[1]] || restoredPoint[t[2]]))
-          continue;
-        Triangle c;
-        for (int k = 0; k < 3; ++k)
-        {
-          const auto it = compact.emplace(t[k], static_cast<int>(changed.Points.size())).first;
-          if (it->second == static_cast<int>(changed.Points.size()))
-            changed.Points.push_back(envelope.Points[t[k]]);
-          c[k] = it->second;
-        }
-        changed.Triangles.push_back(c);
+        changedTriangle[f] = restoredPoint[t[0]] || restoredPoint[t[1]] || restoredPoint[t[2]];
       }
+      const TriangleMesh changed = submesh(envelope, changedTriangle);
       TriangleIndex near;
       near.build(changed);
       for (std::size_t f = 0; f < nf; ++f)

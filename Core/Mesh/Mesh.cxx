@@ -198,31 +198,40 @@ std::array<Vec3, 2> bounds(const TriangleMesh& mesh)
 
 void removeUnreferencedPoints(TriangleMesh& mesh)
 {
+  mesh = submesh(mesh, std::vector<char>(mesh.Triangles.size(), 1));
+}
+
+TriangleMesh submesh(const TriangleMesh& mesh, const std::vector<char>& keep)
+{
+  TriangleMesh out;
   std::vector<int> map(mesh.Points.size(), -1);
-  for (const Triangle& t : mesh.Triangles)
+  std::size_t kept = 0;
+  for (std::size_t f = 0; f < mesh.Triangles.size(); ++f)
   {
-    for (int i : t)
-    {
-      map[i] = 0;
-    }
+    if (!keep[f])
+      continue;
+    ++kept;
+    for (int i : mesh.Triangles[f])
+      map[static_cast<std::size_t>(i)] = 0;
   }
-  int n = 0;
   for (std::size_t i = 0; i < map.size(); ++i)
   {
     if (map[i] == 0)
     {
-      mesh.Points[n] = mesh.Points[i];
-      map[i] = n++;
+      map[i] = static_cast<int>(out.Points.size());
+      out.Points.push_back(mesh.Points[i]);
     }
   }
-  mesh.Points.resize(n);
-  for (Triangle& t : mesh.Triangles)
+  out.Triangles.reserve(kept);
+  for (std::size_t f = 0; f < mesh.Triangles.size(); ++f)
   {
-    for (int& i : t)
-    {
-      i = map[i];
-    }
+    if (!keep[f])
+      continue;
+    const Triangle& t = mesh.Triangles[f];
+    out.Triangles.push_back({ map[static_cast<std::size_t>(t[0])], map[static_cast<std::size_t>(t[1])],
+      map[static_cast<std::size_t>(t[2])] });
   }
+  return out;
 }
 
 } // namespace sdfcage

@@ -81,4 +81,8 @@ std::array<Vec3, 2> bounds(const TriangleMesh& mesh);
 /// Removes points no triangle references; keeps the order of the others.
 void removeUnreferencedPoints(TriangleMesh& mesh);
 
+/// The triangles f with keep[f] (in their order) and only the points they use (in the mesh's
+/// order), without copying the rest of the mesh.
+TriangleMesh submesh(const TriangleMesh& mesh, const std::vector<char>& keep);
+
 } // namespace sdfcage

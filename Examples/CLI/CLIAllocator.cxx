@@ -43,17 +43,25 @@ extern char** environ;
 namespace sdfcage_cli
 {
 
+std::vector<std::string> allocatorEnvironment()
+{
+  std::vector<std::string> names;
+#if defined(__GLIBC__) && defined(__linux__)
+  for (char** e = environ; e && *e; ++e)
+    if (std::strncmp(*e, "GLIBC_TUNABLES=", 15) == 0 || std::strncmp(*e, "MALLOC_", 7) == 0)
+      names.emplace_back(*e, std::strchr(*e, '=') - *e);
+#endif
+  return names;
+}
+
 AllocatorTuning tuneAllocator()
 {
   AllocatorTuning t;
 #if defined(__GLIBC__) && defined(__linux__)
-  for (char** e = environ; e && *e; ++e)
+  if (!allocatorEnvironment().empty())
   {
-    if (std::strncmp(*e, "GLIBC_TUNABLES=", 15) == 0 || std::strncmp(*e, "MALLOC_", 7) == 0)
-    {
-      t.Skipped = true; // the user's own settings
-      return t;
-    }
+    t.Skipped = true; // the user's own settings
+    return t;
   }
   constexpr std::size_t MB = std::size_t(1) << 20;
   t.Tuned = mallopt(M_MMAP_THRESHOLD, static_cast<int>(32 * MB)) == 1 &&

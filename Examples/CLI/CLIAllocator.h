@@ -3,6 +3,8 @@
 #pragma once
 
 #include <cstddef>
+#include <string>
+#include <vector>
 
 namespace sdfcage_cli
 {
@@ -17,5 +19,9 @@ struct AllocatorTuning
 
 /// Call first thing in main(), before any thread starts. A no-op off glibc/Linux.
 AllocatorTuning tuneAllocator();
+
+/// The environment variables by which the user tunes the allocator (GLIBC_TUNABLES, MALLOC_*),
+/// by name: tuneAllocator() does nothing when there is one. Empty off glibc/Linux.
+std::vector<std::string> allocatorEnvironment();
 
 } // namespace sdfcage_cli

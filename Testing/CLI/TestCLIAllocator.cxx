@@ -16,18 +16,12 @@
 #include <string>
 #include <vector>
 
-extern char** environ;
-
 namespace
 {
 
 void clearAllocatorEnvironment()
 {
-  std::vector<std::string> names;
-  for (char** e = environ; e && *e; ++e)
-    if (std::strncmp(*e, "GLIBC_TUNABLES=", 15) == 0 || std::strncmp(*e, "MALLOC_", 7) == 0)
-      names.emplace_back(*e, std::strchr(*e, '=') - *e);
-  for (const std::string& n : names)
+  for (const std::string& n : sdfcage_cli::allocatorEnvironment())
     unsetenv(n.c_str());
 }
 
@@ -119,7 +113,10 @@ TEST(CLIAllocator, ReservesAHugePageHeapThatServesLaterBlocks)
 TEST(CLIAllocator, LeavesTheUsersSettingsAlone)
 {
   clearAllocatorEnvironment();
+  EXPECT_TRUE(sdfcage_cli::allocatorEnvironment().empty());
   setenv("MALLOC_ARENA_MAX", "4", 1);
+  setenv("NOT_MALLOC_ARENA_MAX", "4", 1); // not the allocator's
+  EXPECT_EQ(sdfcage_cli::allocatorEnvironment(), std::vector<std::string>{ "MALLOC_ARENA_MAX" });
   const sdfcage_cli::AllocatorTuning t = sdfcage_cli::tuneAllocator();
   EXPECT_TRUE(t.Skipped);
   EXPECT_FALSE(t.Tuned);
