@@ -504,6 +504,7 @@ bool TriangleTree::closestPoint(const Vec3& p, double maxDistance, Vec3& closest
     return false;
   }
   double best2 = maxDistance < 0 ? std::numeric_limits<double>::infinity() : maxDistance * maxDistance;
+  const double margin = this->slabMargin(p.cwiseAbs().maxCoeff());
   // Each entry keeps its box distance, measured when its parent was opened: popped nodes are
   // tested against the current best without measuring again.
   struct Pending
@@ -555,7 +556,7 @@ bool TriangleTree::closestPoint(const Vec3& p, double maxDistance, Vec3& closest
     // resolve the same); a slab only prunes
     auto slab2 = [&](int c) {
       const double a = along(n, c, p);
-      const double g = slabGap(n, c, a, a);
+      const double g = slabGap(n, c, a, a, margin);
       return g > 0 ? g * g : 0.0;
     };
     const Pending left{ { n.Child[0], n.Count[0] }, std::max(dl, slab2(0)) },
@@ -670,6 +671,7 @@ double TriangleTree::triangleQuery(const Vec3 t[3], double limit, bool stopAtFir
   }
   const Vec3 tlo = t[0].cwiseMin(t[1]).cwiseMin(t[2]);
   const Vec3 thi = t[0].cwiseMax(t[1]).cwiseMax(t[2]);
+  const double margin = this->slabMargin(tlo.cwiseAbs().cwiseMax(thi.cwiseAbs()).maxCoeff());
   // plane of the query triangle: distance to the triangle >= distance to its plane
   Vec3 normal = (t[1] - t[0]).cross(t[2] - t[0]);
   const double nlen = normal.norm();
@@ -746,7 +748,7 @@ double TriangleTree::triangleQuery(const Vec3 t[3], double limit, bool stopAtFir
         if (gap < best)
         {
           const double a0 = along(n, c, t[0]), a1 = along(n, c, t[1]), a2 = along(n, c, t[2]);
-          gap = std::max(gap, slabGap(n, c, std::min({ a0, a1, a2 }), std::max({ a0, a1, a2 })));
+          gap = std::max(gap, slabGap(n, c, std::min({ a0, a1, a2 }), std::max({ a0, a1, a2 }), margin));
         }
         if (gap < best)
         {

@@ -147,12 +147,14 @@ private:
   void prefetch(const Ref& r) const;
   Vec3 childLo(const QueryNode& q, int c) const { return Vec3(q.Lo[c][0], q.Lo[c][1], q.Lo[c][2]); }
   Vec3 childHi(const QueryNode& q, int c) const { return Vec3(q.Hi[c][0], q.Hi[c][1], q.Hi[c][2]); }
-  // Lower bound of the distance from the points a..b (their range along the child's slab
-  // direction being [lo, hi]) to the child's triangles; <= 0 when the slab does not separate them.
-  double slabGap(const QueryNode& q, int c, double lo, double hi) const
+  // Lower bound of the distance from some points (their range along the child's slab direction
+  // being [lo, hi]) to the child's triangles; <= 0 when the slab does not separate them. The
+  // margin covers the rounding of the dot products: slabMargin(the points' largest coordinate).
+  double slabGap(const QueryNode& q, int c, double lo, double hi, double margin) const
   {
-    return std::max(static_cast<double>(q.SlabLo[c]) - hi, lo - static_cast<double>(q.SlabHi[c])) - SlabMargin;
+    return std::max(static_cast<double>(q.SlabLo[c]) - hi, lo - static_cast<double>(q.SlabHi[c])) - margin;
   }
+  double slabMargin(double queryScale) const { return SlabMargin + 1e-13 * queryScale; }
   double along(const QueryNode& q, int c, const Vec3& p) const
   {
     return static_cast<double>(q.Normal[c][0]) * p.x() + static_cast<double>(q.Normal[c][1]) * p.y() +
@@ -160,7 +162,7 @@ private:
   }
   std::vector<Node> Nodes;
   std::vector<QueryNode> QueryNodes;
-  double SlabMargin = 0.0; // rounding of the dot products along a slab direction (coordinates' scale)
+  double SlabMargin = 0.0; // rounding of the dot products along a slab direction (the tree's coordinates)
   Ref Root{ 0, 0 }; // the root as a child reference (a leaf when the tree has one node)
   std::vector<Dipole> Dipoles;
   std::vector<Tri3> Tri;
