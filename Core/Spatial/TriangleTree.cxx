@@ -5,6 +5,7 @@
 #include "Spatial/Geometry.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <cmath>
 #include <limits>
 #include <numeric>
@@ -823,6 +824,145 @@ double TriangleTree::triangleDistance(const Vec3 t[3], double limit) const
 bool TriangleTree::anyCloserThan(const Vec3 t[3], double delta) const
 {
   return this->triangleQuery(t, delta, true) < delta;
+}
+
+bool TriangleTree::anyCloserThanAny(const Vec3* const* tris, int count, double delta) const
+{
+  if (count <= 0 || Nodes.empty())
+  {
+    return false;
+  }
+  if (count > 32)
+  {
+    return this->anyCloserThanAny(tris, 32, delta) || this->anyCloserThanAny(tris + 32, count - 32, delta);
+  }
+  // per query triangle what triangleQuery measures: its box, its plane and side planes
+  struct Query
+  {
+    Vec3 Lo, Hi, Normal, Side[3];
+    double Offset = 0.0, SideOffset[3] = { 0.0, 0.0, 0.0 }, Margin = 0.0;
+    bool HasPlane = false;
+  };
+  Query q[32];
+  for (int i = 0; i < count; ++i)
+  {
+    const Vec3* t = tris[i];
+    Query& Q = q[i];
+    Q.Lo = t[0].cwiseMin(t[1]).cwiseMin(t[2]);
+    Q.Hi = t[0].cwiseMax(t[1]).cwiseMax(t[2]);
+    Q.Margin = this->slabMargin(Q.Lo.cwiseAbs().cwiseMax(Q.Hi.cwiseAbs()).maxCoeff());
+    Q.Normal = (t[1] - t[0]).cross(t[2] - t[0]);
+    const double nlen = Q.Normal.norm();
+    Q.HasPlane = nlen > 0.0;
+    if (!Q.HasPlane)
+      continue;
+    Q.Normal /= nlen;
+    Q.Offset = Q.Normal.dot(t[0]);
+    for (int k = 0; k < 3; ++k)
+    {
+      Q.Side[k] = (t[(k + 1) % 3] - t[k]).cross(Q.Normal);
+      const double len = Q.Side[k].norm();
+      Q.Side[k] = len > 0 ? Vec3(Q.Side[k] / len) : Vec3(Vec3::Zero());
+      Q.SideOffset[k] = std::max({ Q.Side[k].dot(t[0]), Q.Side[k].dot(t[1]), Q.Side[k].dot(t[2]) });
+    }
+  }
+  const double delta2 = delta * delta;
+  // may query i's walk enter the box [lo, hi] (child c of node n, or the root)? As triangleQuery
+  // with limit delta: the box distance, the plane gap, the slab gap
+  auto enters = [&](const Query& Q, const Vec3* t, const Vec3& lo, const Vec3& hi, const QueryNode* n, int c) {
+    if (boxBoxDistance2(lo, hi, Q.Lo, Q.Hi) >= delta2)
+      return false;
+    if (Q.HasPlane)
+    {
+      const Vec3 m = 0.5 * (lo + hi), e = 0.5 * (hi - lo);
+      const double r = std::abs(Q.Normal.x()) * e.x() + std::abs(Q.Normal.y()) * e.y() + std::abs(Q.Normal.z()) * e.z();
+      double gap = std::abs(Q.Normal.dot(m) - Q.Offset) - r;
+      for (int k = 0; k < 3; ++k)
+      {
+        const Vec3& s = Q.Side[k];
+        const double below = s.dot(m) - std::abs(s.x()) * e.x() - std::abs(s.y()) * e.y() - std::abs(s.z()) * e.z();
+        gap = std::max(gap, below - Q.SideOffset[k]);
+      }
+      if (gap >= delta)
+        return false;
+    }
+    if (n)
+    {
+      const double a0 = along(*n, c, t[0]), a1 = along(*n, c, t[1]), a2 = along(*n, c, t[2]);
+      if (slabGap(*n, c, std::min({ a0, a1, a2 }), std::max({ a0, a1, a2 }), Q.Margin) >= delta)
+        return false;
+    }
+    return true;
+  };
+  struct Pending
+  {
+    Ref R;
+    std::uint32_t Mask;
+  };
+  Pending stack[128];
+  int top = 0;
+  std::uint32_t rootMask = 0;
+  for (int i = 0; i < count; ++i)
+    if (enters(q[i], tris[i], Nodes[0].Lo, Nodes[0].Hi, nullptr, 0))
+      rootMask |= std::uint32_t(1) << i;
+  if (rootMask)
+    stack[top++] = { Root, rootMask };
+  while (top)
+  {
+    const Pending e = stack[--top];
+    if (e.R.Count == 0)
+    {
+      const QueryNode& n = QueryNodes[static_cast<std::size_t>(e.R.Child)];
+      for (int c = 0; c < 2; ++c)
+      {
+        const Vec3 lo = childLo(n, c), hi = childHi(n, c);
+        std::uint32_t mask = 0;
+        for (std::uint32_t m = e.Mask; m; m &= m - 1)
+        {
+          const int i = __builtin_ctz(m);
+          if (enters(q[i], tris[i], lo, hi, &n, c))
+            mask |= std::uint32_t(1) << i;
+        }
+        if (mask)
+        {
+          stack[top++] = { { n.Child[c], n.Count[c] }, mask };
+          this->prefetch(stack[top - 1].R);
+        }
+      }
+      continue;
+    }
+    for (int j = e.R.Child; j < e.R.Child + e.R.Count; ++j)
+    {
+      const Tri3& o = Tri[j];
+      for (std::uint32_t m = e.Mask; m; m &= m - 1)
+      {
+        const int i = __builtin_ctz(m);
+        const Query& Q = q[i];
+        const Vec3* t = tris[i];
+        if (!Pieces.empty() && boxBoxDistance2(Pieces[j].Lo, Pieces[j].Hi, Q.Lo, Q.Hi) >= delta2)
+          continue;
+        if (Q.HasPlane)
+        {
+          const double s0 = Q.Normal.dot(o.P[0]) - Q.Offset, s1 = Q.Normal.dot(o.P[1]) - Q.Offset,
+                       s2 = Q.Normal.dot(o.P[2]) - Q.Offset;
+          if (std::min({ s0, s1, s2 }) >= delta || std::max({ s0, s1, s2 }) <= -delta)
+            continue;
+          bool outside = false;
+          for (int k = 0; k < 3 && !outside; ++k)
+            outside =
+              std::min({ Q.Side[k].dot(o.P[0]), Q.Side[k].dot(o.P[1]), Q.Side[k].dot(o.P[2]) }) - Q.SideOffset[k] >=
+              delta;
+          if (outside)
+            continue;
+        }
+        if (separatedFromTriangle(o.P, t, delta))
+          continue;
+        if (trianglesCloserThan(t, o.P, delta))
+          return true;
+      }
+    }
+  }
+  return false;
 }
 
 long long TriangleTree::countWithin(const Vec3 t[3], double delta) const

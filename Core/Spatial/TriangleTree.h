@@ -40,6 +40,11 @@ public:
   double triangleDistance(const Vec3 t[3], double limit) const;
   /// True when some mesh triangle comes closer than `delta` to triangle t (stops at the first).
   bool anyCloserThan(const Vec3 t[3], double delta) const;
+  /// Is some triangle closer than delta to one of the `count` triangles tris[i] (each three
+  /// corners)? The same answer as anyCloserThan on each in turn, from one walk of the tree for
+  /// all of them: the changed triangles of a local change lie together, and share the walk down
+  /// to where they are. At most 32 triangles in one call.
+  bool anyCloserThanAny(const Vec3* const* tris, int count, double delta) const;
   /// Number of mesh triangles at distance <= delta from triangle t (0 counts: intersecting or
   /// touching). Used to count intersecting pairs.
   long long countWithin(const Vec3 t[3], double delta) const;

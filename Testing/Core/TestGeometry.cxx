@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -455,6 +456,7 @@ TEST(TriangleTree, SlabsPruneOnlyWhatIsNotNearer)
   std::mt19937 rng(37);
   std::uniform_real_distribution<double> u(0.0, 1.0);
   int nearer = 0, farther = 0;
+  std::vector<std::array<Vec3, 3>> queries;
   for (int q = 0; q < 400; ++q)
   {
     // a point on one of the surfaces and its outward normal (numerically, from the tree)
@@ -490,6 +492,7 @@ TEST(TriangleTree, SlabsPruneOnlyWhatIsNotNearer)
       const double phi = a + 2.1 * k + 0.3 * u(rng);
       t[k] = c + size * (std::cos(phi) * e1 + std::sin(phi) * e2) + 0.1 * size * (u(rng) - 0.5) * normal;
     }
+    queries.push_back({ t[0], t[1], t[2] });
     double brute = std::numeric_limits<double>::infinity();
     std::vector<int> within;
     for (std::size_t f = 0; f < m.Triangles.size(); ++f)
@@ -531,6 +534,49 @@ TEST(TriangleTree, SlabsPruneOnlyWhatIsNotNearer)
   // both sides of the limit are exercised
   EXPECT_GT(nearer, 60);
   EXPECT_GT(farther, 60);
+
+  // Several triangles in one walk (anyCloserThanAny, for a local change's triangles): the same
+  // answer as each on its own, for groups of one to 40 (over 32: in parts), where all are clear
+  // and where only one is not (the last, the first, or in the middle).
+  const double delta = 0.012;
+  std::vector<char> single(queries.size());
+  std::vector<std::size_t> clear, notClear;
+  for (std::size_t k = 0; k < queries.size(); ++k)
+  {
+    single[k] = whole.anyCloserThan(queries[k].data(), delta);
+    (single[k] ? notClear : clear).push_back(k);
+  }
+  ASSERT_GT(clear.size(), 80u);
+  ASSERT_GT(notClear.size(), 40u);
+  int groups = 0, groupsNotClear = 0;
+  for (int size : { 1, 2, 7, 32, 33, 40 })
+    for (int trial = 0; trial < 30; ++trial)
+    {
+      std::vector<std::size_t> members;
+      for (int i = 0; i < size; ++i)
+        members.push_back(
+          clear[(static_cast<std::size_t>(trial) * 7 + static_cast<std::size_t>(i) * 3) % clear.size()]);
+      if (trial % 3 != 0)
+      {
+        // one not clear, at the end, the start or the middle
+        const std::size_t at = trial % 3 == 1 ? members.size() - 1 : (trial % 2 ? 0 : members.size() / 2);
+        members[at] = notClear[static_cast<std::size_t>(trial) % notClear.size()];
+      }
+      std::vector<const Vec3*> group;
+      bool expected = false;
+      for (std::size_t k : members)
+      {
+        group.push_back(queries[k].data());
+        expected = expected || single[k];
+      }
+      for (const TriangleTree* tree : { &whole, &pieces })
+        EXPECT_EQ(tree->anyCloserThanAny(group.data(), static_cast<int>(group.size()), delta), expected)
+          << "group of " << size << ", trial " << trial;
+      ++groups;
+      groupsNotClear += expected ? 1 : 0;
+    }
+  EXPECT_GT(groupsNotClear, 60);
+  EXPECT_LT(groupsNotClear, groups);
 }
 
 TEST(Geometry, CloserThanAgreesWithTheDistance)
