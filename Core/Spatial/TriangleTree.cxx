@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <cmath>
 #include <limits>
+#include <new>
 #include <numeric>
 
 #include <tbb/blocked_range.h>
@@ -664,58 +665,111 @@ bool separatedFromTriangle(const Vec3 o[3], const Vec3 t[3], double gap)
 }
 } // namespace
 
+// The query triangle's bounds that both triangle walks test: its box, its plane and its three
+// side planes (through an edge, containing the normal, facing out). The triangle lies on the inner
+// side of each, so anything at least d beyond one of them is at least d from the triangle.
+struct TriangleTree::QueryTriangle
+{
+  const Vec3* T;
+  Vec3 Lo, Hi, Normal, Side[3];
+  double Offset = 0.0, SideOffset[3] = { 0.0, 0.0, 0.0 }, Margin;
+  bool HasPlane;
+
+  QueryTriangle(const Vec3 t[3], const TriangleTree& tree)
+    : T(t)
+    , Lo(t[0].cwiseMin(t[1]).cwiseMin(t[2]))
+    , Hi(t[0].cwiseMax(t[1]).cwiseMax(t[2]))
+    , Normal((t[1] - t[0]).cross(t[2] - t[0]))
+    , Margin(tree.slabMargin(Lo.cwiseAbs().cwiseMax(Hi.cwiseAbs()).maxCoeff()))
+  {
+    const double nlen = Normal.norm();
+    HasPlane = nlen > 0.0;
+    if (!HasPlane)
+    {
+      return;
+    }
+    Normal /= nlen;
+    Offset = Normal.dot(t[0]);
+    for (int k = 0; k < 3; ++k)
+    {
+      Side[k] = (t[(k + 1) % 3] - t[k]).cross(Normal);
+      const double len = Side[k].norm();
+      Side[k] = len > 0 ? Vec3(Side[k] / len) : Vec3(Vec3::Zero());
+      // the offset includes the query's own corners, so the triangle is on the inner side even
+      // when its rounded normal is slightly off (slivers)
+      SideOffset[k] = std::max({ Side[k].dot(t[0]), Side[k].dot(t[1]), Side[k].dot(t[2]) });
+    }
+  }
+  double box2(const Vec3& lo, const Vec3& hi) const { return boxBoxDistance2(lo, hi, Lo, Hi); }
+  // lower bound of the distance to the box [lo, hi] by the plane and the side planes (>= 0)
+  double planeGap(const Vec3& lo, const Vec3& hi) const
+  {
+    if (!HasPlane)
+    {
+      return 0.0;
+    }
+    const Vec3 c = 0.5 * (lo + hi), e = 0.5 * (hi - lo);
+    const double s = Normal.dot(c) - Offset;
+    const double r = std::abs(Normal.x()) * e.x() + std::abs(Normal.y()) * e.y() + std::abs(Normal.z()) * e.z();
+    double gap = std::abs(s) - r;
+    for (int k = 0; k < 3; ++k)
+    {
+      const Vec3& m = Side[k];
+      const double below = m.dot(c) - std::abs(m.x()) * e.x() - std::abs(m.y()) * e.y() - std::abs(m.z()) * e.z();
+      gap = std::max(gap, below - SideOffset[k]);
+    }
+    return std::max(0.0, gap);
+  }
+  // lower bound of the distance to child c of node n by its slab
+  double slabGap(const TriangleTree& tree, const QueryNode& n, int c) const
+  {
+    const double a0 = tree.along(n, c, T[0]), a1 = tree.along(n, c, T[1]), a2 = tree.along(n, c, T[2]);
+    return tree.slabGap(n, c, std::min({ a0, a1, a2 }), std::max({ a0, a1, a2 }), Margin);
+  }
+  // is triangle o at least d beyond the plane (either side) or beyond one of the side planes?
+  bool separates(const Vec3 o[3], double d) const
+  {
+    if (!HasPlane)
+    {
+      return false;
+    }
+    const double s0 = Normal.dot(o[0]) - Offset, s1 = Normal.dot(o[1]) - Offset, s2 = Normal.dot(o[2]) - Offset;
+    if (std::min({ s0, s1, s2 }) >= d || std::max({ s0, s1, s2 }) <= -d)
+    {
+      return true;
+    }
+    for (int k = 0; k < 3; ++k)
+    {
+      if (std::min({ Side[k].dot(o[0]), Side[k].dot(o[1]), Side[k].dot(o[2]) }) - SideOffset[k] >= d)
+      {
+        return true;
+      }
+    }
+    return false;
+  }
+  // may the exact test of o find it closer than d? (o's piece box, the query's planes, o's planes)
+  bool leafMayBeCloser(const TriangleTree& tree, int entry, double d) const
+  {
+    // a piece whose box is beyond d: the triangle's nearest point lies in another piece
+    if (!tree.Pieces.empty() && box2(tree.Pieces[entry].Lo, tree.Pieces[entry].Hi) >= d * d)
+    {
+      return false;
+    }
+    const Vec3* o = tree.Tri[entry].P;
+    // the same two tests from the other side: the query beyond the input triangle's plane or
+    // beyond one of its side planes by d (about 40% of the exact distances dragon_quartet's
+    // queries computed end there)
+    return !separates(o, d) && !separatedFromTriangle(o, T, d);
+  }
+};
+
 double TriangleTree::triangleQuery(const Vec3 t[3], double limit, bool stopAtFirst, std::vector<int>* within) const
 {
   if (Nodes.empty())
   {
     return limit;
   }
-  const Vec3 tlo = t[0].cwiseMin(t[1]).cwiseMin(t[2]);
-  const Vec3 thi = t[0].cwiseMax(t[1]).cwiseMax(t[2]);
-  const double margin = this->slabMargin(tlo.cwiseAbs().cwiseMax(thi.cwiseAbs()).maxCoeff());
-  // plane of the query triangle: distance to the triangle >= distance to its plane
-  Vec3 normal = (t[1] - t[0]).cross(t[2] - t[0]);
-  const double nlen = normal.norm();
-  const bool hasPlane = nlen > 0.0;
-  if (hasPlane)
-  {
-    normal /= nlen;
-  }
-  const double offset = hasPlane ? normal.dot(t[0]) : 0.0;
-  // the three side planes of the query triangle (through an edge, containing the normal, facing
-  // out): the triangle lies on their inner side, so anything at least d beyond one of them is at
-  // least d from the triangle
-  Vec3 side[3];
-  double sideOffset[3] = { 0.0, 0.0, 0.0 };
-  if (hasPlane)
-  {
-    for (int i = 0; i < 3; ++i)
-    {
-      side[i] = (t[(i + 1) % 3] - t[i]).cross(normal);
-      const double len = side[i].norm();
-      side[i] = len > 0 ? Vec3(side[i] / len) : Vec3(Vec3::Zero());
-      // the offset includes the query's own corners, so the triangle is on the inner side even
-      // when its rounded normal is slightly off (slivers)
-      sideOffset[i] = std::max({ side[i].dot(t[0]), side[i].dot(t[1]), side[i].dot(t[2]) });
-    }
-  }
-  auto planeGap = [&](const Vec3& lo, const Vec3& hi) {
-    if (!hasPlane)
-    {
-      return 0.0;
-    }
-    const Vec3 c = 0.5 * (lo + hi), e = 0.5 * (hi - lo);
-    const double s = normal.dot(c) - offset;
-    const double r = std::abs(normal.x()) * e.x() + std::abs(normal.y()) * e.y() + std::abs(normal.z()) * e.z();
-    double gap = std::abs(s) - r;
-    for (int i = 0; i < 3; ++i)
-    {
-      const Vec3& m = side[i];
-      const double below = m.dot(c) - std::abs(m.x()) * e.x() - std::abs(m.y()) * e.y() - std::abs(m.z()) * e.z();
-      gap = std::max(gap, below - sideOffset[i]);
-    }
-    return std::max(0.0, gap);
-  };
+  const QueryTriangle q(t, *this);
   double best = limit;
   // Each entry keeps its two lower bounds (box distance squared, plane gap), measured when its
   // parent was opened and tested again when popped, as `best` may have shrunk meanwhile.
@@ -728,7 +782,7 @@ double TriangleTree::triangleQuery(const Vec3 t[3], double limit, bool stopAtFir
   auto far = [&best](double box2, double gap) { return box2 >= best * best || gap >= best; };
   Pending stack[128];
   int top = 0;
-  stack[top++] = { Root, boxBoxDistance2(Nodes[0].Lo, Nodes[0].Hi, tlo, thi), planeGap(Nodes[0].Lo, Nodes[0].Hi) };
+  stack[top++] = { Root, q.box2(Nodes[0].Lo, Nodes[0].Hi), q.planeGap(Nodes[0].Lo, Nodes[0].Hi) };
   while (top)
   {
     const Pending e = stack[--top];
@@ -742,14 +796,13 @@ double TriangleTree::triangleQuery(const Vec3 t[3], double limit, bool stopAtFir
       for (int c = 0; c < 2; ++c)
       {
         const Vec3 lo = childLo(n, c), hi = childHi(n, c);
-        const double box2 = boxBoxDistance2(lo, hi, tlo, thi);
+        const double box2 = q.box2(lo, hi);
         if (box2 >= best * best)
           continue;
-        double gap = planeGap(lo, hi);
+        double gap = q.planeGap(lo, hi);
         if (gap < best)
         {
-          const double a0 = along(n, c, t[0]), a1 = along(n, c, t[1]), a2 = along(n, c, t[2]);
-          gap = std::max(gap, slabGap(n, c, std::min({ a0, a1, a2 }), std::max({ a0, a1, a2 }), margin));
+          gap = std::max(gap, q.slabGap(*this, n, c));
         }
         if (gap < best)
         {
@@ -761,37 +814,11 @@ double TriangleTree::triangleQuery(const Vec3 t[3], double limit, bool stopAtFir
     }
     for (int i = e.R.Child; i < e.R.Child + e.R.Count; ++i)
     {
+      if (!q.leafMayBeCloser(*this, i, best))
+      {
+        continue;
+      }
       const Tri3& o = Tri[i];
-      // a piece whose box is beyond the limit: the triangle's nearest point lies in another piece
-      if (!Pieces.empty() && boxBoxDistance2(Pieces[i].Lo, Pieces[i].Hi, tlo, thi) >= best * best)
-      {
-        continue;
-      }
-      if (hasPlane)
-      {
-        const double s0 = normal.dot(o.P[0]) - offset, s1 = normal.dot(o.P[1]) - offset,
-                     s2 = normal.dot(o.P[2]) - offset;
-        if (std::min({ s0, s1, s2 }) >= best || std::max({ s0, s1, s2 }) <= -best)
-        {
-          continue;
-        }
-        bool outside = false;
-        for (int k = 0; k < 3 && !outside; ++k)
-        {
-          outside = std::min({ side[k].dot(o.P[0]), side[k].dot(o.P[1]), side[k].dot(o.P[2]) }) - sideOffset[k] >= best;
-        }
-        if (outside)
-        {
-          continue;
-        }
-      }
-      // the same two tests from the other side: the query beyond the input triangle's plane or
-      // beyond one of its side planes by `best` (about 40% of the exact distances dragon_quartet's
-      // queries computed end here)
-      if (separatedFromTriangle(o.P, t, best))
-      {
-        continue;
-      }
       if (within || stopAtFirst)
       {
         // only "closer than the limit?" is asked (the limit never shrinks): answered without the
@@ -836,63 +863,18 @@ bool TriangleTree::anyCloserThanAny(const Vec3* const* tris, int count, double d
   {
     return this->anyCloserThanAny(tris, 32, delta) || this->anyCloserThanAny(tris + 32, count - 32, delta);
   }
-  // per query triangle what triangleQuery measures: its box, its plane and side planes
-  struct Query
-  {
-    Vec3 Lo, Hi, Normal, Side[3];
-    double Offset = 0.0, SideOffset[3] = { 0.0, 0.0, 0.0 }, Margin = 0.0;
-    bool HasPlane = false;
-  };
-  Query q[32];
+  // per query triangle what triangleQuery measures
+  alignas(QueryTriangle) unsigned char storage[32 * sizeof(QueryTriangle)];
+  QueryTriangle* q = reinterpret_cast<QueryTriangle*>(storage);
   for (int i = 0; i < count; ++i)
   {
-    const Vec3* t = tris[i];
-    Query& Q = q[i];
-    Q.Lo = t[0].cwiseMin(t[1]).cwiseMin(t[2]);
-    Q.Hi = t[0].cwiseMax(t[1]).cwiseMax(t[2]);
-    Q.Margin = this->slabMargin(Q.Lo.cwiseAbs().cwiseMax(Q.Hi.cwiseAbs()).maxCoeff());
-    Q.Normal = (t[1] - t[0]).cross(t[2] - t[0]);
-    const double nlen = Q.Normal.norm();
-    Q.HasPlane = nlen > 0.0;
-    if (!Q.HasPlane)
-      continue;
-    Q.Normal /= nlen;
-    Q.Offset = Q.Normal.dot(t[0]);
-    for (int k = 0; k < 3; ++k)
-    {
-      Q.Side[k] = (t[(k + 1) % 3] - t[k]).cross(Q.Normal);
-      const double len = Q.Side[k].norm();
-      Q.Side[k] = len > 0 ? Vec3(Q.Side[k] / len) : Vec3(Vec3::Zero());
-      Q.SideOffset[k] = std::max({ Q.Side[k].dot(t[0]), Q.Side[k].dot(t[1]), Q.Side[k].dot(t[2]) });
-    }
+    new (q + i) QueryTriangle(tris[i], *this);
   }
   const double delta2 = delta * delta;
   // may query i's walk enter the box [lo, hi] (child c of node n, or the root)? As triangleQuery
   // with limit delta: the box distance, the plane gap, the slab gap
-  auto enters = [&](const Query& Q, const Vec3* t, const Vec3& lo, const Vec3& hi, const QueryNode* n, int c) {
-    if (boxBoxDistance2(lo, hi, Q.Lo, Q.Hi) >= delta2)
-      return false;
-    if (Q.HasPlane)
-    {
-      const Vec3 m = 0.5 * (lo + hi), e = 0.5 * (hi - lo);
-      const double r = std::abs(Q.Normal.x()) * e.x() + std::abs(Q.Normal.y()) * e.y() + std::abs(Q.Normal.z()) * e.z();
-      double gap = std::abs(Q.Normal.dot(m) - Q.Offset) - r;
-      for (int k = 0; k < 3; ++k)
-      {
-        const Vec3& s = Q.Side[k];
-        const double below = s.dot(m) - std::abs(s.x()) * e.x() - std::abs(s.y()) * e.y() - std::abs(s.z()) * e.z();
-        gap = std::max(gap, below - Q.SideOffset[k]);
-      }
-      if (gap >= delta)
-        return false;
-    }
-    if (n)
-    {
-      const double a0 = along(*n, c, t[0]), a1 = along(*n, c, t[1]), a2 = along(*n, c, t[2]);
-      if (slabGap(*n, c, std::min({ a0, a1, a2 }), std::max({ a0, a1, a2 }), Q.Margin) >= delta)
-        return false;
-    }
-    return true;
+  auto enters = [&](const QueryTriangle& Q, const Vec3& lo, const Vec3& hi, const QueryNode* n, int c) {
+    return Q.box2(lo, hi) < delta2 && Q.planeGap(lo, hi) < delta && (!n || Q.slabGap(*this, *n, c) < delta);
   };
   struct Pending
   {
@@ -903,7 +885,7 @@ bool TriangleTree::anyCloserThanAny(const Vec3* const* tris, int count, double d
   int top = 0;
   std::uint32_t rootMask = 0;
   for (int i = 0; i < count; ++i)
-    if (enters(q[i], tris[i], Nodes[0].Lo, Nodes[0].Hi, nullptr, 0))
+    if (enters(q[i], Nodes[0].Lo, Nodes[0].Hi, nullptr, 0))
       rootMask |= std::uint32_t(1) << i;
   if (rootMask)
     stack[top++] = { Root, rootMask };
@@ -920,7 +902,7 @@ bool TriangleTree::anyCloserThanAny(const Vec3* const* tris, int count, double d
         for (std::uint32_t m = e.Mask; m; m &= m - 1)
         {
           const int i = __builtin_ctz(m);
-          if (enters(q[i], tris[i], lo, hi, &n, c))
+          if (enters(q[i], lo, hi, &n, c))
             mask |= std::uint32_t(1) << i;
         }
         if (mask)
@@ -933,31 +915,10 @@ bool TriangleTree::anyCloserThanAny(const Vec3* const* tris, int count, double d
     }
     for (int j = e.R.Child; j < e.R.Child + e.R.Count; ++j)
     {
-      const Tri3& o = Tri[j];
       for (std::uint32_t m = e.Mask; m; m &= m - 1)
       {
         const int i = __builtin_ctz(m);
-        const Query& Q = q[i];
-        const Vec3* t = tris[i];
-        if (!Pieces.empty() && boxBoxDistance2(Pieces[j].Lo, Pieces[j].Hi, Q.Lo, Q.Hi) >= delta2)
-          continue;
-        if (Q.HasPlane)
-        {
-          const double s0 = Q.Normal.dot(o.P[0]) - Q.Offset, s1 = Q.Normal.dot(o.P[1]) - Q.Offset,
-                       s2 = Q.Normal.dot(o.P[2]) - Q.Offset;
-          if (std::min({ s0, s1, s2 }) >= delta || std::max({ s0, s1, s2 }) <= -delta)
-            continue;
-          bool outside = false;
-          for (int k = 0; k < 3 && !outside; ++k)
-            outside =
-              std::min({ Q.Side[k].dot(o.P[0]), Q.Side[k].dot(o.P[1]), Q.Side[k].dot(o.P[2]) }) - Q.SideOffset[k] >=
-              delta;
-          if (outside)
-            continue;
-        }
-        if (separatedFromTriangle(o.P, t, delta))
-          continue;
-        if (trianglesCloserThan(t, o.P, delta))
+        if (q[i].leafMayBeCloser(*this, j, delta) && trianglesCloserThan(tris[i], Tri[j].P, delta))
           return true;
       }
     }

@@ -110,6 +110,9 @@ private:
   // below `limit` as soon as one triangle is closer than it (not the distance); with `within`,
   // every triangle closer than `limit` is listed and `limit` returned.
   double triangleQuery(const Vec3 t[3], double limit, bool stopAtFirst, std::vector<int>* within = nullptr) const;
+  // A query triangle's box, plane and side planes, and the bounds the triangle walks take from them
+  // (TriangleTree.cxx).
+  struct QueryTriangle;
   struct Dipole
   {
     Vec3 Center = Vec3::Zero();     // area centroid of the node's triangles
