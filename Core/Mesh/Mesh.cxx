@@ -196,40 +196,72 @@ std::array<Vec3, 2> bounds(const TriangleMesh& mesh)
   return { lo, hi };
 }
 
+namespace
+{
+// New numbers of the points the triangles f with keep(f) use, in the mesh's order (-1 for the
+// others), and how many they are.
+template <typename Keep>
+std::vector<int> usedPointNumbers(const TriangleMesh& mesh, Keep keep, std::size_t& used)
+{
+  std::vector<int> map(mesh.Points.size(), -1);
+  for (std::size_t f = 0; f < mesh.Triangles.size(); ++f)
+  {
+    if (keep(f))
+    {
+      for (int i : mesh.Triangles[f])
+        map[static_cast<std::size_t>(i)] = 0;
+    }
+  }
+  used = 0;
+  for (int& m : map)
+  {
+    if (m == 0)
+      m = static_cast<int>(used++);
+  }
+  return map;
+}
+
+Triangle renumbered(const Triangle& t, const std::vector<int>& map)
+{
+  return { map[static_cast<std::size_t>(t[0])], map[static_cast<std::size_t>(t[1])],
+    map[static_cast<std::size_t>(t[2])] };
+}
+} // namespace
+
 void removeUnreferencedPoints(TriangleMesh& mesh)
 {
-  mesh = submesh(mesh, std::vector<char>(mesh.Triangles.size(), 1));
+  std::size_t used = 0;
+  const std::vector<int> map = usedPointNumbers(
+    mesh, [](std::size_t) { return true; }, used);
+  // in place: a point's new number is never above its old one
+  for (std::size_t i = 0; i < map.size(); ++i)
+  {
+    if (map[i] >= 0)
+      mesh.Points[static_cast<std::size_t>(map[i])] = mesh.Points[i];
+  }
+  mesh.Points.resize(used);
+  for (Triangle& t : mesh.Triangles)
+    t = renumbered(t, map);
 }
 
 TriangleMesh submesh(const TriangleMesh& mesh, const std::vector<char>& keep)
 {
   TriangleMesh out;
-  std::vector<int> map(mesh.Points.size(), -1);
-  std::size_t kept = 0;
-  for (std::size_t f = 0; f < mesh.Triangles.size(); ++f)
-  {
-    if (!keep[f])
-      continue;
-    ++kept;
-    for (int i : mesh.Triangles[f])
-      map[static_cast<std::size_t>(i)] = 0;
-  }
+  std::size_t used = 0;
+  const std::vector<int> map = usedPointNumbers(
+    mesh, [&keep](std::size_t f) { return keep[f] != 0; }, used);
+  out.Points.resize(used);
   for (std::size_t i = 0; i < map.size(); ++i)
   {
-    if (map[i] == 0)
-    {
-      map[i] = static_cast<int>(out.Points.size());
-      out.Points.push_back(mesh.Points[i]);
-    }
+    if (map[i] >= 0)
+      out.Points[static_cast<std::size_t>(map[i])] = mesh.Points[i];
   }
-  out.Triangles.reserve(kept);
+  out.Triangles.reserve(
+    static_cast<std::size_t>(std::count_if(keep.begin(), keep.end(), [](char k) { return k != 0; })));
   for (std::size_t f = 0; f < mesh.Triangles.size(); ++f)
   {
-    if (!keep[f])
-      continue;
-    const Triangle& t = mesh.Triangles[f];
-    out.Triangles.push_back({ map[static_cast<std::size_t>(t[0])], map[static_cast<std::size_t>(t[1])],
-      map[static_cast<std::size_t>(t[2])] });
+    if (keep[f])
+      out.Triangles.push_back(renumbered(mesh.Triangles[f], map));
   }
   return out;
 }
