@@ -437,11 +437,13 @@ std::size_t liftCutCorners(
 {
   std::size_t added = 0;
   std::atomic<std::size_t> skipped{ 0 };
+  const auto tl = std::chrono::steady_clock::now();
   std::size_t firstNew = 0; // triangles with a point at or beyond it are measured
   for (int round = 0; round < rounds && envelope.Triangles.size() < maxTriangles; ++round)
   {
     const std::size_t nf = envelope.Triangles.size();
     std::vector<char> bad(nf, 0);
+    const auto tm = std::chrono::steady_clock::now();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, nf, 512), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t f = r.begin(); f != r.end(); ++f)
       {
@@ -452,6 +454,9 @@ std::size_t liftCutCorners(
         bad[f] = tree.anyCloserThan(tri, margin) ? 1 : 0;
       }
     });
+    if (std::getenv("SDFCAGE_DEBUG_ENVELOPE"))
+      std::fprintf(stderr, "lift round %d: %zu triangles measured in %.4f s, %ld closer than %g\n", round, nf,
+        seconds(tm), static_cast<long>(std::count(bad.begin(), bad.end(), 1)), margin);
     std::vector<std::uint64_t> keys;
     for (std::size_t f = 0; f < nf; ++f)
     {
@@ -475,11 +480,26 @@ std::size_t liftCutCorners(
       break;
     std::sort(keys.begin(), keys.end());
     keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+    // the ends of the edges to split: the passes below look up only edges between two of them
+    // (up to six rounds of lookups for every edge of the surface; median of 5, both extractions:
+    // octopus-low 0.041 -> 0.029 s, decimated-knight 0.048 -> 0.030 s, armadillo 0.044 -> 0.036 s)
+    std::vector<char> end(envelope.Points.size(), 0);
+    for (std::uint64_t key : keys)
+    {
+      end[static_cast<std::size_t>(key >> 32)] = 1;
+      end[static_cast<std::size_t>(key & 0xFFFFFFFFu)] = 1;
+    }
+    const auto marked = [&](int a, int b) {
+      return end[static_cast<std::size_t>(a)] && end[static_cast<std::size_t>(b)] &&
+        std::binary_search(keys.begin(), keys.end(), edgeKey(a, b));
+    };
     // the surface's normal along each edge to split (its two triangles' area-weighted normals)
     std::vector<Vec3> edgeNormal(keys.size(), Vec3::Zero());
     for (const Triangle& t : envelope.Triangles)
       for (int k = 0; k < 3; ++k)
       {
+        if (!end[static_cast<std::size_t>(t[k])] || !end[static_cast<std::size_t>(t[(k + 1) % 3])])
+          continue;
         const std::uint64_t key = edgeKey(t[k], t[(k + 1) % 3]);
         const auto it = std::lower_bound(keys.begin(), keys.end(), key);
         if (it != keys.end() && *it == key)
@@ -488,8 +508,7 @@ std::size_t liftCutCorners(
       }
     const std::size_t before = envelope.Points.size();
     std::vector<std::array<int, 2>> parents;
-    splitEdges(
-      envelope, [&](int a, int b) { return std::binary_search(keys.begin(), keys.end(), edgeKey(a, b)); }, &parents);
+    splitEdges(envelope, marked, &parents);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(before, envelope.Points.size(), 256),
       [&](const tbb::blocked_range<std::size_t>& r) {
         for (std::size_t i = r.begin(); i != r.end(); ++i)
@@ -517,7 +536,7 @@ std::size_t liftCutCorners(
     firstNew = before;
   }
   if (std::getenv("SDFCAGE_DEBUG_ENVELOPE"))
-    std::fprintf(stderr, "lift: %zu points added, %zu not moved\n", added, skipped.load());
+    std::fprintf(stderr, "lift: %zu points added, %zu not moved, %.4f s\n", added, skipped.load(), seconds(tl));
   return added;
 }
 
@@ -830,6 +849,8 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
       auto t0 = std::chrono::steady_clock::now();
       int pockets = 0;
       TriangleMesh envelope = outerBoundary(surface, pockets);
+      if (std::getenv("SDFCAGE_DEBUG_ENVELOPE"))
+        std::fprintf(stderr, "judge: outer boundary %.4f s\n", seconds(t0));
       if (progressCancelled(progress))
       {
         return false; // computeIsosurface reports the cancel
@@ -911,6 +932,8 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
           projectOntoAmplifiedOffset(envelope, *amplification, surfaceTree ? *surfaceTree : tree(), c, 0.5 * h);
       }
       result.IsosurfaceSeconds += seconds(t0);
+      if (std::getenv("SDFCAGE_DEBUG_ENVELOPE"))
+        std::fprintf(stderr, "judge: boundary, lift and projection %.4f s\n", seconds(t0));
       progressStage(progress, "verifying enclosure", 0.7 * progressEnd, progressEnd);
       auto t1 = std::chrono::steady_clock::now();
       std::string why;
@@ -960,6 +983,8 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
         }
       }
       result.VerificationSeconds += seconds(t1);
+      if (std::getenv("SDFCAGE_DEBUG_ENVELOPE"))
+        std::fprintf(stderr, "judge: verification %.4f s (%s)\n", seconds(t1), ok ? "passed" : "failed");
       if (ok && !withMemo)
       {
         // (the accepted envelope's parts and genus: not part of the verification's time, which

@@ -1136,6 +1136,9 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
         bool stopped = false;
         surface = extract(grid, iso, adaptivity, noAdapt->empty() ? nullptr : noAdapt, progress, stopped);
         extractionSeconds += seconds(te);
+        if (std::getenv("SDFCAGE_DEBUG_ENVELOPE"))
+          std::fprintf(stderr, "extraction (adaptivity %g, round %d): %zu triangles, %.4f s\n", adaptivity, round,
+            surface.Triangles.size(), seconds(te));
         if (stopped)
         {
           out.Cancelled = true;
