@@ -921,10 +921,15 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
           return true; // stops the extraction
         }
       }
+      KnownClearTriangles lifted;
       if (adaptivity > 0.0 && options.LiftCutCorners && !(amplification && !amplification->empty()))
       {
+        // (the extraction's points keep their ids and positions: its triangles the lifting left
+        // unsplit were measured clear of the input by 1.2 delta)
+        lifted.Below = envelope.Points.size();
+        lifted.Distance = 1.2 * delta;
         result.LiftedPoints +=
-          liftCutCorners(envelope, tree(), c, 1.2 * delta, 6, 4 * envelope.Triangles.size() + 1024);
+          liftCutCorners(envelope, tree(), c, lifted.Distance, 6, 4 * envelope.Triangles.size() + 1024);
       }
       if (amplification && !amplification->empty())
       {
@@ -946,7 +951,7 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
       const MeshDefects checked = withMemo ? checkTriangleMesh(envelope) : MeshDefects();
       const bool ok = options.DeferVerification ||
         (withMemo ? verifyEnclosureWithMemo(
-                      unitInput, envelope, delta, clearance, why, &distances, progress, tree(), memo, &checked)
+                      unitInput, envelope, delta, clearance, why, &distances, progress, tree(), memo, &checked, &lifted)
                   : verifyEnclosure(unitInput, envelope, delta, clearance, why, &distances, progress,
                       options.ExactEnvelopeClearance, &tree()));
       result.VerificationDeferred = options.DeferVerification;

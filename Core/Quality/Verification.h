@@ -51,6 +51,16 @@ struct VerificationMemo
   std::shared_ptr<Store> Known; ///< what the next surface may reuse (internal)
 };
 
+/// What the caller knows of a surface's clearance before its check: no input triangle comes
+/// closer than `Distance` to a triangle whose three corners all have ids below `Below` (the
+/// adaptive envelope's lifting measured every triangle of the extraction, whose points come
+/// first, and split every one it found closer).
+struct KnownClearTriangles
+{
+  std::size_t Below = 0;
+  double Distance = 0.0;
+};
+
 /// verifyEnclosure with `exactMinimum` false (the same answer, `why` and certified clearance), for
 /// a surface that shares triangles with the one `memo` last saw: a triangle whose three corners
 /// are the same points (the same doubles, the same orientation) as a sound triangle of that
@@ -60,9 +70,12 @@ struct VerificationMemo
 /// position. Every pair involving a new triangle, every new triangle's clearance, the 2-manifold
 /// test and the winding numbers are checked as usual. Fills memo.Defective and replaces what the
 /// memo keeps with this surface's findings. `checked`, if given, is checkTriangleMesh(surface)
-/// (saves computing it again).
+/// (saves computing it again). `clear`, if given and its Distance is at least the clearance,
+/// spares the exact clearance test of the triangles it covers (with the same result: the test
+/// would find nothing closer than the clearance).
 bool verifyEnclosureWithMemo(const TriangleMesh& input, const TriangleMesh& surface, double clearance,
   double& measuredClearance, std::string& why, std::vector<double>* pointDistances, Progress* progress,
-  const TriangleTree& inputTree, VerificationMemo& memo, const MeshDefects* checked = nullptr);
+  const TriangleTree& inputTree, VerificationMemo& memo, const MeshDefects* checked = nullptr,
+  const KnownClearTriangles* clear = nullptr);
 
 } // namespace sdfcage

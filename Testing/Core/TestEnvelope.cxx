@@ -570,6 +570,74 @@ TEST(VerificationMemo, ReusedFindingsGiveTheFullCheckAnswer)
   EXPECT_EQ(memo.Reused, 0u);
 }
 
+// What the lifting of an adaptive envelope knows (KnownClearTriangles: the extraction's triangles
+// it measured clear and left unsplit) spares their exact clearance tests and changes no answer;
+// a claim below the clearance is not taken, and a claim is taken on trust (it is the caller's).
+TEST(VerificationMemo, KnownClearTrianglesGiveTheSameAnswer)
+{
+  const TriangleMesh input = makeSphere(Vec3(0, 0, 0), 0.5, 24, 12);
+  const TriangleMesh sound = makeSphere(Vec3(0.003, -0.002, 0.001), 0.56, 40, 20);
+  const double clearance = 0.02;
+  const TriangleTree tree(input);
+  TriangleMesh nearInput = sound;
+  nearInput.Points[300] *= 0.5 / nearInput.Points[300].norm();
+  struct Answer
+  {
+    bool Ok;
+    std::string Why;
+    double Measured = -1.0;
+    std::vector<double> Distances;
+    std::vector<char> Defective;
+  };
+  const auto check = [&](const TriangleMesh& surface, const KnownClearTriangles* clear) {
+    VerificationMemo memo; // a new sequence each time
+    Answer a;
+    a.Ok = verifyEnclosureWithMemo(
+      input, surface, clearance, a.Measured, a.Why, &a.Distances, nullptr, tree, memo, nullptr, clear);
+    a.Defective = memo.Defective;
+    return a;
+  };
+  const auto expectSame = [](const Answer& a, const Answer& b) {
+    EXPECT_EQ(a.Ok, b.Ok);
+    EXPECT_EQ(a.Why, b.Why);
+    EXPECT_EQ(a.Measured, b.Measured);
+    EXPECT_EQ(a.Distances, b.Distances);
+    EXPECT_EQ(a.Defective, b.Defective);
+  };
+  {
+    SCOPED_TRACE("sound, every triangle known clear");
+    const KnownClearTriangles all{ sound.Points.size(), 1.2 * clearance };
+    const Answer plain = check(sound, nullptr);
+    EXPECT_TRUE(plain.Ok) << plain.Why;
+    expectSame(check(sound, &all), plain);
+  }
+  // the triangles with a corner at or above 300 include those at the pushed vertex
+  const KnownClearTriangles below300{ 300, 1.2 * clearance };
+  const Answer plain = check(nearInput, nullptr);
+  EXPECT_FALSE(plain.Ok);
+  {
+    SCOPED_TRACE("near the input, the triangles away from it known clear");
+    expectSame(check(nearInput, &below300), plain);
+  }
+  // a claim that covers the pushed vertex's triangles: taken (they are not flagged), unless its
+  // distance is below the clearance
+  const KnownClearTriangles wrong{ nearInput.Points.size(), 1.2 * clearance };
+  const Answer trusted = check(nearInput, &wrong);
+  std::size_t flagged = 0, trustedFlagged = 0;
+  for (std::size_t f = 0; f < plain.Defective.size(); ++f)
+  {
+    flagged += plain.Defective[f] != 0;
+    trustedFlagged += trusted.Defective[f] != 0;
+  }
+  EXPECT_GT(flagged, 0u);
+  EXPECT_EQ(trustedFlagged, 0u);
+  const KnownClearTriangles tooClose{ nearInput.Points.size(), 0.9 * clearance };
+  {
+    SCOPED_TRACE("a claim below the clearance");
+    expectSame(check(nearInput, &tooClose), plain);
+  }
+}
+
 TEST(Envelope, LargerIsoValueExplicitAndExactClearance)
 {
   const TriangleMesh input = makeTorus(Vec3(0, 0, 0), 1.0, 0.35, 64, 24);
