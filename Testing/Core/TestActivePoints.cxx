@@ -19,6 +19,7 @@
 #include <cmath>
 #include <iostream>
 #include <limits>
+#include <set>
 
 using namespace sdfcage;
 
@@ -97,6 +98,54 @@ TEST(RefineMesh, SplitsLongEdgesKeepingShapeAndOrientation)
   const MeshDefects d = checkTriangleMesh(fine);
   EXPECT_TRUE(d.usable()) << d.errorMessage(); // closed, manifold, consistently oriented
   EXPECT_EQ(genus(fine), 0);
+}
+
+// One round of splitEdges with a symmetric marking that mixes 1-2, 1-3 and 1-4 splits: one
+// midpoint per marked edge (at its middle, its edge in `parents`), a triangle more per marked edge
+// of each triangle, the surface closed, oriented and of the same area; nothing marked, nothing done.
+TEST(RefineMesh, SplitEdgesMakesOneMidpointPerMarkedEdge)
+{
+  TriangleMesh mesh = makeSphere(Vec3(0, 0, 0), 1.0, 24, 12);
+  const TriangleMesh before = mesh;
+  const auto marked = [](int a, int b) { return (a + b) % 3 == 0 || (a * b) % 7 == 1; };
+  std::set<std::pair<int, int>> edges;
+  std::size_t incidences = 0;
+  for (const Triangle& t : before.Triangles)
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      const int a = t[k], b = t[(k + 1) % 3];
+      if (marked(a, b))
+      {
+        edges.insert({ std::min(a, b), std::max(a, b) });
+        ++incidences;
+      }
+    }
+  }
+  ASSERT_GT(edges.size(), 100u);
+  std::vector<std::array<int, 2>> parents;
+  const std::size_t made = splitEdges(mesh, marked, &parents);
+  EXPECT_EQ(made, edges.size());
+  ASSERT_EQ(mesh.Points.size(), before.Points.size() + edges.size());
+  ASSERT_EQ(parents.size(), edges.size());
+  EXPECT_EQ(mesh.Triangles.size(), before.Triangles.size() + incidences);
+  std::set<std::pair<int, int>> split;
+  for (std::size_t i = 0; i < parents.size(); ++i)
+  {
+    const int a = parents[i][0], b = parents[i][1];
+    split.insert({ std::min(a, b), std::max(a, b) });
+    EXPECT_EQ(mesh.Points[before.Points.size() + i], 0.5 * (before.Points[a] + before.Points[b]));
+  }
+  EXPECT_EQ(split, edges);
+  EXPECT_NEAR(totalArea(mesh), totalArea(before), 1e-12);
+  EXPECT_NEAR(signedVolume(mesh), signedVolume(before), 1e-12);
+  const MeshDefects d = checkTriangleMesh(mesh);
+  EXPECT_TRUE(d.usable()) << d.errorMessage();
+  // nothing marked
+  TriangleMesh same = before;
+  EXPECT_EQ(splitEdges(same, [](int, int) { return false; }), 0u);
+  EXPECT_EQ(same.Points, before.Points);
+  EXPECT_EQ(same.Triangles, before.Triangles);
 }
 
 TEST(ActivePoints, SphereHasNone)
