@@ -8,7 +8,6 @@
 #include <cstdint>
 #include <cmath>
 #include <limits>
-#include <new>
 #include <numeric>
 
 #include <tbb/blocked_range.h>
@@ -670,18 +669,21 @@ bool separatedFromTriangle(const Vec3 o[3], const Vec3 t[3], double gap)
 // side of each, so anything at least d beyond one of them is at least d from the triangle.
 struct TriangleTree::QueryTriangle
 {
-  const Vec3* T;
+  const Vec3* T = nullptr;
   Vec3 Lo, Hi, Normal, Side[3];
-  double Offset = 0.0, SideOffset[3] = { 0.0, 0.0, 0.0 }, Margin;
-  bool HasPlane;
+  double Offset = 0.0, SideOffset[3] = { 0.0, 0.0, 0.0 }, Margin = 0.0;
+  bool HasPlane = false;
 
-  QueryTriangle(const Vec3 t[3], const TriangleTree& tree)
-    : T(t)
-    , Lo(t[0].cwiseMin(t[1]).cwiseMin(t[2]))
-    , Hi(t[0].cwiseMax(t[1]).cwiseMax(t[2]))
-    , Normal((t[1] - t[0]).cross(t[2] - t[0]))
-    , Margin(tree.slabMargin(Lo.cwiseAbs().cwiseMax(Hi.cwiseAbs()).maxCoeff()))
+  QueryTriangle() = default;
+  QueryTriangle(const Vec3 t[3], const TriangleTree& tree) { this->set(t, tree); }
+  void set(const Vec3 t[3], const TriangleTree& tree)
   {
+    T = t;
+    Lo = t[0].cwiseMin(t[1]).cwiseMin(t[2]);
+    Hi = t[0].cwiseMax(t[1]).cwiseMax(t[2]);
+    Normal = (t[1] - t[0]).cross(t[2] - t[0]);
+    Margin = tree.slabMargin(Lo.cwiseAbs().cwiseMax(Hi.cwiseAbs()).maxCoeff());
+    Offset = 0.0;
     const double nlen = Normal.norm();
     HasPlane = nlen > 0.0;
     if (!HasPlane)
@@ -864,11 +866,10 @@ bool TriangleTree::anyCloserThanAny(const Vec3* const* tris, int count, double d
     return this->anyCloserThanAny(tris, 32, delta) || this->anyCloserThanAny(tris + 32, count - 32, delta);
   }
   // per query triangle what triangleQuery measures
-  alignas(QueryTriangle) unsigned char storage[32 * sizeof(QueryTriangle)];
-  QueryTriangle* q = reinterpret_cast<QueryTriangle*>(storage);
+  QueryTriangle q[32];
   for (int i = 0; i < count; ++i)
   {
-    new (q + i) QueryTriangle(tris[i], *this);
+    q[i].set(tris[i], *this);
   }
   const double delta2 = delta * delta;
   // may query i's walk enter the box [lo, hi] (child c of node n, or the root)? As triangleQuery
