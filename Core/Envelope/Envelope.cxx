@@ -16,6 +16,7 @@
 #include <tbb/task_group.h>
 
 #include <algorithm>
+#include <cstddef>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -489,21 +490,23 @@ std::size_t liftCutCorners(
       end[static_cast<std::size_t>(key >> 32)] = 1;
       end[static_cast<std::size_t>(key & 0xFFFFFFFFu)] = 1;
     }
-    const auto marked = [&](int a, int b) {
-      return end[static_cast<std::size_t>(a)] && end[static_cast<std::size_t>(b)] &&
-        std::binary_search(keys.begin(), keys.end(), edgeKey(a, b));
+    // the edge a-b's index in keys, or -1 when it is not to be split
+    const auto edgeIndex = [&](int a, int b) -> std::ptrdiff_t {
+      if (!end[static_cast<std::size_t>(a)] || !end[static_cast<std::size_t>(b)])
+        return -1;
+      const std::uint64_t key = edgeKey(a, b);
+      const auto it = std::lower_bound(keys.begin(), keys.end(), key);
+      return it != keys.end() && *it == key ? it - keys.begin() : -1;
     };
+    const auto marked = [&](int a, int b) { return edgeIndex(a, b) >= 0; };
     // the surface's normal along each edge to split (its two triangles' area-weighted normals)
     std::vector<Vec3> edgeNormal(keys.size(), Vec3::Zero());
     for (const Triangle& t : envelope.Triangles)
       for (int k = 0; k < 3; ++k)
       {
-        if (!end[static_cast<std::size_t>(t[k])] || !end[static_cast<std::size_t>(t[(k + 1) % 3])])
-          continue;
-        const std::uint64_t key = edgeKey(t[k], t[(k + 1) % 3]);
-        const auto it = std::lower_bound(keys.begin(), keys.end(), key);
-        if (it != keys.end() && *it == key)
-          edgeNormal[it - keys.begin()] +=
+        const std::ptrdiff_t e = edgeIndex(t[k], t[(k + 1) % 3]);
+        if (e >= 0)
+          edgeNormal[static_cast<std::size_t>(e)] +=
             (envelope.Points[t[1]] - envelope.Points[t[0]]).cross(envelope.Points[t[2]] - envelope.Points[t[0]]);
       }
     const std::size_t before = envelope.Points.size();
@@ -520,7 +523,7 @@ std::size_t liftCutCorners(
           if (!tree.closestPoint(x, c, cp, t, d) || !(d < c))
             continue;
           const std::array<int, 2>& ab = parents[i - before];
-          const Vec3 n = edgeNormal[std::lower_bound(keys.begin(), keys.end(), edgeKey(ab[0], ab[1])) - keys.begin()];
+          const Vec3 n = edgeNormal[static_cast<std::size_t>(edgeIndex(ab[0], ab[1]))];
           const Vec3 dir = x - cp;
           // out only: a midpoint whose way away from the input is not the surface's outside (it
           // lies inside a thin part the chord crosses, or the input turns there) stays for now
