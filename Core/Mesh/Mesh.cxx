@@ -221,6 +221,17 @@ std::vector<int> usedPointNumbers(const TriangleMesh& mesh, Keep keep, std::size
   return map;
 }
 
+// to[map[i]] = from[i] for every used point i. from and to may be the same vector: a point's new
+// number is never above its old one, so in place each point is read before it is overwritten
+void gatherPoints(const std::vector<int>& map, const std::vector<Vec3>& from, std::vector<Vec3>& to)
+{
+  for (std::size_t i = 0; i < map.size(); ++i)
+  {
+    if (map[i] >= 0)
+      to[static_cast<std::size_t>(map[i])] = from[i];
+  }
+}
+
 Triangle renumbered(const Triangle& t, const std::vector<int>& map)
 {
   return { map[static_cast<std::size_t>(t[0])], map[static_cast<std::size_t>(t[1])],
@@ -233,12 +244,7 @@ void removeUnreferencedPoints(TriangleMesh& mesh)
   std::size_t used = 0;
   const std::vector<int> map = usedPointNumbers(
     mesh, [](std::size_t) { return true; }, used);
-  // in place: a point's new number is never above its old one
-  for (std::size_t i = 0; i < map.size(); ++i)
-  {
-    if (map[i] >= 0)
-      mesh.Points[static_cast<std::size_t>(map[i])] = mesh.Points[i];
-  }
+  gatherPoints(map, mesh.Points, mesh.Points);
   mesh.Points.resize(used);
   for (Triangle& t : mesh.Triangles)
     t = renumbered(t, map);
@@ -251,11 +257,7 @@ TriangleMesh submesh(const TriangleMesh& mesh, const std::vector<char>& keep)
   const std::vector<int> map = usedPointNumbers(
     mesh, [&keep](std::size_t f) { return keep[f] != 0; }, used);
   out.Points.resize(used);
-  for (std::size_t i = 0; i < map.size(); ++i)
-  {
-    if (map[i] >= 0)
-      out.Points[static_cast<std::size_t>(map[i])] = mesh.Points[i];
-  }
+  gatherPoints(map, mesh.Points, out.Points);
   out.Triangles.reserve(
     static_cast<std::size_t>(std::count_if(keep.begin(), keep.end(), [](char k) { return k != 0; })));
   for (std::size_t f = 0; f < mesh.Triangles.size(); ++f)
