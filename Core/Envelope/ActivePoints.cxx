@@ -869,11 +869,8 @@ std::size_t splitEdges(
     ++made;
     return id;
   };
-  mesh.Points.reserve(mesh.Points.size() + marking);
-  if (parents)
-  {
-    parents->reserve(parents->size() + marking);
-  }
+  // the points grow by push_back (geometrically over refineMesh's rounds); the triangles are a
+  // new list each round, reserved for what the marks make
   std::vector<Triangle> next;
   next.reserve(mesh.Triangles.size() + 2 * marking);
   for (std::size_t f = 0; f < mesh.Triangles.size(); ++f)
