@@ -102,6 +102,69 @@ INSTANTIATE_TEST_SUITE_P(Meshes, ActivePointData,
     return n;
   });
 
+// The adaptive envelope's cut corners mended on real meshes (liftCutCorners in Envelope.cxx): at
+// the defaults the first extraction's badly placed points are lifted, its midpoints traced out
+// where their closest-point way is not the outside, and lifted points that make the surface cross
+// itself lifted less or put back; on these meshes that leaves nothing for verification to find,
+// so the envelope is accepted without a second, partly uniform extraction (before session 50
+// each needed one: clearance defects at unmoved midpoints, crossings at lifted ones). Judged
+// again by the CGAL checker.
+class FirstExtractionData : public ::testing::TestWithParam<std::string>
+{
+};
+
+TEST_P(FirstExtractionData, LiftedEnvelopePassesWithoutReExtraction)
+{
+  const std::string path = gDataDir + "/" + GetParam();
+  if (gDataDir.empty() || !std::ifstream(path).good())
+  {
+    GTEST_SKIP() << "mesh '" << path << "' is absent (data folder '" << gDataDir << "')";
+  }
+  PolygonMesh raw;
+  std::string error;
+  ASSERT_TRUE(exact::readPolygonMesh(path, raw, error)) << error;
+  TriangleMesh mesh;
+  const MeshDefects d = prepareMesh(raw, mesh, ValidationOptions());
+  ASSERT_TRUE(d.usable()) << d.errorMessage();
+  const TriangleMesh unit = Normalization::fit(mesh).toUnit(mesh);
+  std::vector<int> comp;
+  const int components = triangleComponents(unit, comp);
+  const int inputGenus = genus(unit);
+
+  const EnvelopeOptions options;
+  const EnvelopeResult env = buildEnvelope(unit, options);
+  ASSERT_EQ(env.State, Status::Ok) << env.Message;
+  std::cout << "[ lift     ] " << GetParam() << ": " << env.Envelope.Triangles.size() << " triangles, "
+            << env.LiftedPoints << " points added, " << env.AdaptiveRepairs << " re-extractions\n";
+  EXPECT_GT(env.LiftedPoints, 0u) << "nothing lifted: the test does not test the lifting";
+  EXPECT_EQ(env.AdaptiveRepairs, 0) << "the lifted first extraction failed verification";
+  EXPECT_EQ(env.Genus, inputGenus);
+  EXPECT_EQ(env.Components, components);
+
+  const exact::ExactReport r = exact::exactCheck(unit, env.Envelope, 2.0 * options.IsoValue);
+  std::cout << "[ exact    ] clearance " << r.MinimumClearance << " (promised " << options.clearance() << ")\n";
+  EXPECT_TRUE(r.Closed2Manifold);
+  EXPECT_EQ(r.SelfIntersections, 0);
+  EXPECT_EQ(r.InputIntersections, 0);
+  EXPECT_EQ(r.InputVerticesOutside, 0);
+  EXPECT_TRUE(r.Encloses);
+  EXPECT_GE(r.MinimumClearance, options.clearance() * (1.0 - 1e-9));
+  EXPECT_EQ(r.CageGenus, inputGenus);
+  EXPECT_EQ(r.CageComponents, components);
+}
+
+INSTANTIATE_TEST_SUITE_P(Meshes, FirstExtractionData,
+  ::testing::Values(std::string("armadillo.obj"), std::string("bunny.off"), std::string("bunny_watertight.obj"),
+    std::string("horse.ply")),
+  [](const ::testing::TestParamInfo<std::string>& info) {
+    std::string n = info.param.substr(0, info.param.find('.'));
+    for (char& ch : n)
+    {
+      ch = std::isalnum(static_cast<unsigned char>(ch)) ? ch : '_';
+    }
+    return n;
+  });
+
 int main(int argc, char** argv)
 {
   ::testing::InitGoogleTest(&argc, argv);
