@@ -165,6 +165,77 @@ void markSelfIntersecting(const TriangleMesh& surface, std::vector<char>& bad, c
   });
 }
 
+/// markSelfIntersecting with `only` for a few selected triangles of a large surface: only the
+/// triangles whose boxes meet a selected one's are indexed, found through a bitmap of coarse cells
+/// (at most 128 along the surface's longest side, none smaller than the largest selected
+/// triangle) that the selected boxes cover, not the whole surface. The lifting asks this up to 13
+/// times per envelope for a few dozen to a few hundred lifted triangles of 10-25k: indexing the
+/// whole surface each time was 60% of the lifting (decimated-knight 0.028 of 0.047 s).
+void markSelfIntersectingNear(const TriangleMesh& surface, const std::vector<char>& only, std::vector<char>& bad)
+{
+  const std::size_t nf = surface.Triangles.size();
+  bad.assign(nf, 0);
+  std::vector<Vec3> lo(nf), hi(nf);
+  Vec3 all[2] = { Vec3::Constant(std::numeric_limits<double>::max()),
+    Vec3::Constant(-std::numeric_limits<double>::max()) };
+  double largest = 0.0;
+  for (std::size_t f = 0; f < nf; ++f)
+  {
+    const Triangle& t = surface.Triangles[f];
+    const Vec3 &a = surface.Points[t[0]], &b = surface.Points[t[1]], &c = surface.Points[t[2]];
+    lo[f] = a.cwiseMin(b).cwiseMin(c);
+    hi[f] = a.cwiseMax(b).cwiseMax(c);
+    all[0] = all[0].cwiseMin(lo[f]);
+    all[1] = all[1].cwiseMax(hi[f]);
+    if (only[f])
+      largest = std::max(largest, (hi[f] - lo[f]).maxCoeff());
+  }
+  if (!(largest > 0.0))
+    return; // nothing selected (or only degenerate points, which cross nothing)
+  const double cell = std::max(largest, (all[1] - all[0]).maxCoeff() / 128.0);
+  std::int64_t dims[3];
+  for (int k = 0; k < 3; ++k)
+    dims[k] = static_cast<std::int64_t>(std::floor((all[1][k] - all[0][k]) / cell)) + 1;
+  std::vector<std::uint64_t> covered(static_cast<std::size_t>((dims[0] * dims[1] * dims[2] + 63) / 64), 0);
+  // calls visit(cell index) for every cell the box of f covers, until it returns true
+  const auto anyCell = [&](std::size_t f, auto&& visit) {
+    std::int64_t a[3], b[3];
+    for (int k = 0; k < 3; ++k)
+    {
+      a[k] = std::min(dims[k] - 1, static_cast<std::int64_t>(std::floor((lo[f][k] - all[0][k]) / cell)));
+      b[k] = std::min(dims[k] - 1, static_cast<std::int64_t>(std::floor((hi[f][k] - all[0][k]) / cell)));
+    }
+    for (std::int64_t k = a[2]; k <= b[2]; ++k)
+      for (std::int64_t j = a[1]; j <= b[1]; ++j)
+        for (std::int64_t i = a[0]; i <= b[0]; ++i)
+          if (visit(static_cast<std::size_t>((k * dims[1] + j) * dims[0] + i)))
+            return true;
+    return false;
+  };
+  for (std::size_t f = 0; f < nf; ++f)
+    if (only[f])
+      anyCell(f, [&](std::size_t c) {
+        covered[c >> 6] |= std::uint64_t(1) << (c & 63);
+        return false;
+      });
+  std::vector<char> keep(nf, 0);
+  for (std::size_t f = 0; f < nf; ++f)
+    keep[f] = only[f] || anyCell(f, [&](std::size_t c) { return ((covered[c >> 6] >> (c & 63)) & 1) != 0; });
+  // (submesh keeps the kept triangles in order and numbers their points alike, so shared corners
+  // are still shared for the conflict test)
+  const TriangleMesh near = submesh(surface, keep);
+  std::vector<char> nearOnly, nearBad;
+  nearOnly.reserve(near.Triangles.size());
+  for (std::size_t f = 0; f < nf; ++f)
+    if (keep[f])
+      nearOnly.push_back(only[f]);
+  markSelfIntersecting(near, nearBad, &nearOnly);
+  std::size_t g = 0;
+  for (std::size_t f = 0; f < nf; ++f)
+    if (keep[f])
+      bad[f] = nearBad[g++];
+}
+
 /// Points on every flagged triangle of `surface`, about one voxel apart: where an adaptive
 /// extraction is repeated without adaptivity.
 std::vector<Vec3> pointsOnTriangles(const TriangleMesh& surface, const std::vector<char>& flagged, double voxel)
@@ -463,7 +534,7 @@ void uncrossLifted(TriangleMesh& envelope, const TriangleTree& tree, const std::
           any = only[f] = 1;
     if (!any)
       return;
-    markSelfIntersecting(envelope, crossing, &only);
+    markSelfIntersectingNear(envelope, only, crossing);
     std::size_t undone = 0;
     for (std::size_t f = 0; f < envelope.Triangles.size(); ++f)
     {
