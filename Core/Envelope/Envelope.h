@@ -58,10 +58,13 @@ struct EnvelopeOptions
   /// the diagonal on armadillo). Merged polygons that break the clearance are re-extracted
   /// without adaptivity around the defect.
   double Adaptivity = 0.3;
-  /// Mend the adaptive envelope's cut corners before verifying it: triangles closer than 1.2
-  /// clearance to the input are split along their longest edge and the new points moved onto the
-  /// offset (see liftCutCorners in Envelope.cxx); what is left goes to the re-extraction without
-  /// adaptivity around it. Not with active points (their amplified projection refines there).
+  /// Mend the adaptive envelope's cut corners before verifying it: the extraction's points and
+  /// triangles closer than 1.2 clearance to the input are lifted onto the offset (triangles split
+  /// along their longest edge first), points whose lift makes the surface cross itself lifted
+  /// less or put back (see liftCutCorners in Envelope.cxx), and a surface that then fails only by
+  /// folds of its own triangles is mended in place and verified again (unfoldCrossings); what is
+  /// left goes to the re-extraction without adaptivity around it. Not with active points (their
+  /// amplified projection refines there).
   bool LiftCutCorners = true;
   /// If verification fails, retry up to this many times with half the voxel size.
   int MaximumRefinements = 2;
