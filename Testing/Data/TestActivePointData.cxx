@@ -31,15 +31,11 @@ namespace
 
 std::string gDataDir;
 
-class ActivePointData : public ::testing::TestWithParam<std::string>
+// the data folder's mesh `name`, prepared and fitted to the unit sphere, with its parts and genus
+// (the test is skipped when it is absent)
+void loadUnitMesh(const std::string& name, TriangleMesh& unit, int& components, int& inputGenus)
 {
-};
-
-} // namespace
-
-TEST_P(ActivePointData, ShapeAwareEnvelopeKeepsTopology)
-{
-  const std::string path = gDataDir + "/" + GetParam();
+  const std::string path = gDataDir + "/" + name;
   if (gDataDir.empty() || !std::ifstream(path).good())
   {
     GTEST_SKIP() << "mesh '" << path << "' is absent (data folder '" << gDataDir << "')";
@@ -50,10 +46,53 @@ TEST_P(ActivePointData, ShapeAwareEnvelopeKeepsTopology)
   TriangleMesh mesh;
   const MeshDefects d = prepareMesh(raw, mesh, ValidationOptions());
   ASSERT_TRUE(d.usable()) << d.errorMessage();
-  const TriangleMesh unit = Normalization::fit(mesh).toUnit(mesh);
+  unit = Normalization::fit(mesh).toUnit(mesh);
   std::vector<int> comp;
-  const int components = triangleComponents(unit, comp);
-  const int inputGenus = genus(unit);
+  components = triangleComponents(unit, comp);
+  inputGenus = genus(unit);
+}
+
+// the CGAL checker's verdict on an envelope: closed, not self-intersecting, enclosing the input
+// with the promised clearance, with the input's genus and parts
+void expectSoundEnvelope(const TriangleMesh& unit, const TriangleMesh& envelope, const EnvelopeOptions& options,
+  int inputGenus, int components)
+{
+  const exact::ExactReport r = exact::exactCheck(unit, envelope, 2.0 * options.IsoValue);
+  std::cout << "[ exact    ] clearance " << r.MinimumClearance << " (promised " << options.clearance() << ")\n";
+  EXPECT_TRUE(r.Closed2Manifold);
+  EXPECT_EQ(r.SelfIntersections, 0);
+  EXPECT_EQ(r.InputIntersections, 0);
+  EXPECT_EQ(r.InputVerticesOutside, 0);
+  EXPECT_TRUE(r.Encloses);
+  EXPECT_GE(r.MinimumClearance, options.clearance() * (1.0 - 1e-9));
+  EXPECT_EQ(r.CageGenus, inputGenus);
+  EXPECT_EQ(r.CageComponents, components);
+}
+
+// a test name from a mesh file name: its stem, other characters than letters and digits as '_'
+std::string meshTestName(const ::testing::TestParamInfo<std::string>& info)
+{
+  std::string n = info.param.substr(0, info.param.find('.'));
+  for (char& ch : n)
+  {
+    ch = std::isalnum(static_cast<unsigned char>(ch)) ? ch : '_';
+  }
+  return n;
+}
+
+class ActivePointData : public ::testing::TestWithParam<std::string>
+{
+};
+
+} // namespace
+
+TEST_P(ActivePointData, ShapeAwareEnvelopeKeepsTopology)
+{
+  TriangleMesh unit;
+  int components = 0, inputGenus = 0;
+  ASSERT_NO_FATAL_FAILURE(loadUnitMesh(GetParam(), unit, components, inputGenus));
+  if (IsSkipped())
+    return;
 
   // the defaults find nothing on these meshes (see above): reported, not asserted
   const ActivePoints defaults = computeActivePoints(unit, ActivePointOptions());
@@ -79,28 +118,11 @@ TEST_P(ActivePointData, ShapeAwareEnvelopeKeepsTopology)
   EXPECT_EQ(env.Components, components);
   EXPECT_TRUE(env.TopologyWarning.empty()) << env.TopologyWarning;
 
-  const exact::ExactReport r = exact::exactCheck(unit, env.Envelope, 2.0 * options.IsoValue);
-  std::cout << "[ exact    ] clearance " << r.MinimumClearance << " (promised " << options.clearance() << ")\n";
-  EXPECT_TRUE(r.Closed2Manifold);
-  EXPECT_EQ(r.SelfIntersections, 0);
-  EXPECT_EQ(r.InputIntersections, 0);
-  EXPECT_EQ(r.InputVerticesOutside, 0);
-  EXPECT_TRUE(r.Encloses);
-  EXPECT_GE(r.MinimumClearance, options.clearance() * (1.0 - 1e-9));
-  EXPECT_EQ(r.CageGenus, inputGenus);
-  EXPECT_EQ(r.CageComponents, components);
+  expectSoundEnvelope(unit, env.Envelope, options, inputGenus, components);
 }
 
 INSTANTIATE_TEST_SUITE_P(Meshes, ActivePointData,
-  ::testing::Values(std::string("hand_fist.off"), std::string("octopus-low_surface.obj")),
-  [](const ::testing::TestParamInfo<std::string>& info) {
-    std::string n = info.param.substr(0, info.param.find('.'));
-    for (char& ch : n)
-    {
-      ch = std::isalnum(static_cast<unsigned char>(ch)) ? ch : '_';
-    }
-    return n;
-  });
+  ::testing::Values(std::string("hand_fist.off"), std::string("octopus-low_surface.obj")), meshTestName);
 
 // The adaptive envelope's cut corners mended on real meshes (liftCutCorners in Envelope.cxx): at
 // the defaults the first extraction's badly placed points are lifted, its midpoints traced out
@@ -116,21 +138,11 @@ class FirstExtractionData : public ::testing::TestWithParam<std::string>
 
 TEST_P(FirstExtractionData, LiftedEnvelopePassesWithoutReExtraction)
 {
-  const std::string path = gDataDir + "/" + GetParam();
-  if (gDataDir.empty() || !std::ifstream(path).good())
-  {
-    GTEST_SKIP() << "mesh '" << path << "' is absent (data folder '" << gDataDir << "')";
-  }
-  PolygonMesh raw;
-  std::string error;
-  ASSERT_TRUE(exact::readPolygonMesh(path, raw, error)) << error;
-  TriangleMesh mesh;
-  const MeshDefects d = prepareMesh(raw, mesh, ValidationOptions());
-  ASSERT_TRUE(d.usable()) << d.errorMessage();
-  const TriangleMesh unit = Normalization::fit(mesh).toUnit(mesh);
-  std::vector<int> comp;
-  const int components = triangleComponents(unit, comp);
-  const int inputGenus = genus(unit);
+  TriangleMesh unit;
+  int components = 0, inputGenus = 0;
+  ASSERT_NO_FATAL_FAILURE(loadUnitMesh(GetParam(), unit, components, inputGenus));
+  if (IsSkipped())
+    return;
 
   const EnvelopeOptions options;
   const EnvelopeResult env = buildEnvelope(unit, options);
@@ -142,29 +154,13 @@ TEST_P(FirstExtractionData, LiftedEnvelopePassesWithoutReExtraction)
   EXPECT_EQ(env.Genus, inputGenus);
   EXPECT_EQ(env.Components, components);
 
-  const exact::ExactReport r = exact::exactCheck(unit, env.Envelope, 2.0 * options.IsoValue);
-  std::cout << "[ exact    ] clearance " << r.MinimumClearance << " (promised " << options.clearance() << ")\n";
-  EXPECT_TRUE(r.Closed2Manifold);
-  EXPECT_EQ(r.SelfIntersections, 0);
-  EXPECT_EQ(r.InputIntersections, 0);
-  EXPECT_EQ(r.InputVerticesOutside, 0);
-  EXPECT_TRUE(r.Encloses);
-  EXPECT_GE(r.MinimumClearance, options.clearance() * (1.0 - 1e-9));
-  EXPECT_EQ(r.CageGenus, inputGenus);
-  EXPECT_EQ(r.CageComponents, components);
+  expectSoundEnvelope(unit, env.Envelope, options, inputGenus, components);
 }
 
 INSTANTIATE_TEST_SUITE_P(Meshes, FirstExtractionData,
   ::testing::Values(std::string("armadillo.obj"), std::string("bunny.off"), std::string("bunny_watertight.obj"),
     std::string("horse.ply"), std::string("octopus-low_surface.obj"), std::string("hand_fist.off")),
-  [](const ::testing::TestParamInfo<std::string>& info) {
-    std::string n = info.param.substr(0, info.param.find('.'));
-    for (char& ch : n)
-    {
-      ch = std::isalnum(static_cast<unsigned char>(ch)) ? ch : '_';
-    }
-    return n;
-  });
+  meshTestName);
 
 int main(int argc, char** argv)
 {
