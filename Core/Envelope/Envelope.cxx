@@ -608,8 +608,7 @@ std::size_t liftCutCorners(
     std::vector<Vec3> normal(envelope.Points.size(), Vec3::Zero());
     for (const Triangle& t : envelope.Triangles)
     {
-      const Vec3 a =
-        (envelope.Points[t[1]] - envelope.Points[t[0]]).cross(envelope.Points[t[2]] - envelope.Points[t[0]]);
+      const Vec3 a = areaNormal(envelope, t);
       for (int k = 0; k < 3; ++k)
         normal[static_cast<std::size_t>(t[k])] += a;
     }
@@ -706,8 +705,7 @@ std::size_t liftCutCorners(
       {
         const std::ptrdiff_t e = edgeIndex(t[k], t[(k + 1) % 3]);
         if (e >= 0)
-          edgeNormal[static_cast<std::size_t>(e)] +=
-            (envelope.Points[t[1]] - envelope.Points[t[0]]).cross(envelope.Points[t[2]] - envelope.Points[t[0]]);
+          edgeNormal[static_cast<std::size_t>(e)] += areaNormal(envelope, t);
       }
     const std::size_t before = envelope.Points.size();
     std::vector<std::array<int, 2>> parents;
@@ -1456,7 +1454,7 @@ double surfaceArea(const TriangleMesh& m)
   double a = 0.0;
   for (const Triangle& t : m.Triangles)
   {
-    a += 0.5 * (m.Points[t[1]] - m.Points[t[0]]).cross(m.Points[t[2]] - m.Points[t[0]]).norm();
+    a += 0.5 * areaNormal(m, t).norm();
   }
   return a;
 }

@@ -567,7 +567,7 @@ MeshDefects checkTriangleMesh(const TriangleMesh& mesh)
   d.Empty = mesh.Triangles.empty();
   for (const Triangle& t : mesh.Triangles)
   {
-    const Vec3 n = (mesh.Points[t[1]] - mesh.Points[t[0]]).cross(mesh.Points[t[2]] - mesh.Points[t[0]]);
+    const Vec3 n = areaNormal(mesh, t);
     if (t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || n.squaredNorm() == 0.0)
     {
       ++d.DegenerateTriangles;

@@ -167,8 +167,7 @@ bool TriangleTree::build(const TriangleMesh& mesh, Progress* progress, bool spli
     for (std::size_t f = r.begin(); f != r.end(); ++f)
     {
       const Triangle& t = mesh.Triangles[f];
-      const Vec3& a = mesh.Points[t[0]];
-      const Vec3 nrm = (mesh.Points[t[1]] - a).cross(mesh.Points[t[2]] - a);
+      const Vec3 nrm = areaNormal(mesh, t);
       Normals[f] = nrm.norm() > 0 ? Vec3(nrm.normalized()) : Vec3(Vec3::Zero());
     }
   });
