@@ -515,15 +515,19 @@ double traceOut(const TriangleTree& tree, const Vec3& x, const Vec3& u, double d
 /// Lifted points whose triangles now cross another triangle of the envelope (moving out of a
 /// concave place can push a point through the surface beside it): first lifted again from where
 /// they were (`from`) only to `low` from the input, along the way from their closest input point,
-/// and where that still crosses, put back. `lifted[p]` flags the points still away from `from`.
+/// and where that still crosses, put back. `lifted[p]` flags the points still away from `from`;
+/// `moved` lists every lifted point with its `from`, in increasing point order.
 void uncrossLifted(TriangleMesh& envelope, const TriangleTree& tree, const std::vector<std::pair<int, Vec3>>& moved,
   std::vector<char>& lifted, double c, double low)
 {
   if (moved.empty())
     return;
-  std::vector<std::size_t> slot(envelope.Points.size(), moved.size());
-  for (std::size_t k = 0; k < moved.size(); ++k)
-    slot[static_cast<std::size_t>(moved[k].first)] = k;
+  // where a lifted point was: `moved` is in increasing point order (few points, many calls)
+  const auto fromOf = [&moved](std::size_t q) -> const Vec3& {
+    return std::lower_bound(moved.begin(), moved.end(), static_cast<int>(q), [](const std::pair<int, Vec3>& m, int p) {
+      return m.first < p;
+    })->second;
+  };
   for (int pass = 0; pass < 2; ++pass)
   {
     std::vector<char> only(envelope.Triangles.size(), 0), crossing;
@@ -545,7 +549,7 @@ void uncrossLifted(TriangleMesh& envelope, const TriangleTree& tree, const std::
         const std::size_t q = static_cast<std::size_t>(p);
         if (!lifted[q])
           continue;
-        const Vec3& from = moved[slot[q]].second;
+        const Vec3& from = fromOf(q);
         Vec3& x = envelope.Points[q];
         Vec3 cp;
         int tq = -1;
