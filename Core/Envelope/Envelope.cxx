@@ -593,12 +593,14 @@ void uncrossLifted(TriangleMesh& envelope, const TriangleTree& tree, const std::
 /// triangles with a new point are measured again, and no point of the extraction moves after the
 /// first measurement (the verification takes its unsplit triangles as measured: KnownClearTriangles).
 /// Stops when no triangle is closer than `margin`, or at `maxTriangles`; verification judges the
-/// result as before, and what it still finds goes to the re-extraction. Measured at the defaults
-/// (session 50, median of 5 whole runs): armadillo, bunny, bunny_watertight, horse and hand_fist
-/// then need one extraction fewer (1.39 -> 1.24 s, 0.73 -> 0.62, 1.00 -> 0.84, 0.76 -> 0.65,
-/// 0.93 -> 0.77), the others as many as before. OpenVDB has no such step; it is a few dozen
-/// lines on top of the mesh refinement the amplified projection uses. Returns the number of
-/// points added.
+/// result as before (folds of the extraction's own triangles: unfoldCrossings), and what it still
+/// finds goes to the re-extraction. Measured at the defaults (session 50, with unfoldCrossings,
+/// median of 5 whole runs; README, "Envelope speed"): armadillo, bunny, bunny_watertight, horse,
+/// octopus-low and hand_fist pass on the first extraction (before: re-extracted once, hand_fist
+/// twice; armadillo 1.24 -> 1.08 s, hand_fist 0.87 -> 0.59 s), anchor, decimated-knight,
+/// decimated-max, fertility and armadillo_midsub4x are still re-extracted once. OpenVDB has no
+/// such step; it is a few dozen lines on top of the mesh refinement the amplified projection
+/// uses. Returns the number of points added.
 std::size_t liftCutCorners(
   TriangleMesh& envelope, const TriangleTree& tree, double c, double margin, int rounds, std::size_t maxTriangles)
 {
