@@ -12,7 +12,7 @@
 #include "../Core/CoreTestPrinters.h"
 #include "Envelope/ActivePoints.h"
 #include "Envelope/Envelope.h"
-#include "ExactCheck.h"
+#include "ExpectSound.h"
 #include "MeshIO.h"
 #include "Mesh/Normalization.h"
 #include "Mesh/Validation.h"
@@ -31,43 +31,34 @@ namespace
 
 std::string gDataDir;
 
-// the data folder's mesh `name`, prepared and fitted to the unit sphere, with its parts and genus
-// (the test is skipped when it is absent)
-void loadUnitMesh(const std::string& name, TriangleMesh& unit, int& components, int& inputGenus)
+// A data mesh's test: SetUp loads the data folder's mesh named by the parameter, prepared and
+// fitted to the unit sphere, with its parts and genus, or skips the test when it is absent.
+class DataMeshTest : public ::testing::TestWithParam<std::string>
 {
-  const std::string path = gDataDir + "/" + name;
-  if (gDataDir.empty() || !std::ifstream(path).good())
+protected:
+  void SetUp() override
   {
-    GTEST_SKIP() << "mesh '" << path << "' is absent (data folder '" << gDataDir << "')";
+    const std::string path = gDataDir + "/" + GetParam();
+    if (gDataDir.empty() || !std::ifstream(path).good())
+    {
+      GTEST_SKIP() << "mesh '" << path << "' is absent (data folder '" << gDataDir << "')";
+    }
+    PolygonMesh raw;
+    std::string error;
+    ASSERT_TRUE(exact::readPolygonMesh(path, raw, error)) << error;
+    TriangleMesh mesh;
+    const MeshDefects d = prepareMesh(raw, mesh, ValidationOptions());
+    ASSERT_TRUE(d.usable()) << d.errorMessage();
+    unit = Normalization::fit(mesh).toUnit(mesh);
+    std::vector<int> comp;
+    components = triangleComponents(unit, comp);
+    inputGenus = genus(unit);
   }
-  PolygonMesh raw;
-  std::string error;
-  ASSERT_TRUE(exact::readPolygonMesh(path, raw, error)) << error;
-  TriangleMesh mesh;
-  const MeshDefects d = prepareMesh(raw, mesh, ValidationOptions());
-  ASSERT_TRUE(d.usable()) << d.errorMessage();
-  unit = Normalization::fit(mesh).toUnit(mesh);
-  std::vector<int> comp;
-  components = triangleComponents(unit, comp);
-  inputGenus = genus(unit);
-}
 
-// the CGAL checker's verdict on an envelope: closed, not self-intersecting, enclosing the input
-// with the promised clearance, with the input's genus and parts
-void expectSoundEnvelope(const TriangleMesh& unit, const TriangleMesh& envelope, const EnvelopeOptions& options,
-  int inputGenus, int components)
-{
-  const exact::ExactReport r = exact::exactCheck(unit, envelope, 2.0 * options.IsoValue);
-  std::cout << "[ exact    ] clearance " << r.MinimumClearance << " (promised " << options.clearance() << ")\n";
-  EXPECT_TRUE(r.Closed2Manifold);
-  EXPECT_EQ(r.SelfIntersections, 0);
-  EXPECT_EQ(r.InputIntersections, 0);
-  EXPECT_EQ(r.InputVerticesOutside, 0);
-  EXPECT_TRUE(r.Encloses);
-  EXPECT_GE(r.MinimumClearance, options.clearance() * (1.0 - 1e-9));
-  EXPECT_EQ(r.CageGenus, inputGenus);
-  EXPECT_EQ(r.CageComponents, components);
-}
+  TriangleMesh unit;
+  int components = 0;
+  int inputGenus = 0;
+};
 
 // a test name from a mesh file name: its stem, other characters than letters and digits as '_'
 std::string meshTestName(const ::testing::TestParamInfo<std::string>& info)
@@ -80,7 +71,7 @@ std::string meshTestName(const ::testing::TestParamInfo<std::string>& info)
   return n;
 }
 
-class ActivePointData : public ::testing::TestWithParam<std::string>
+class ActivePointData : public DataMeshTest
 {
 };
 
@@ -88,12 +79,6 @@ class ActivePointData : public ::testing::TestWithParam<std::string>
 
 TEST_P(ActivePointData, ShapeAwareEnvelopeKeepsTopology)
 {
-  TriangleMesh unit;
-  int components = 0, inputGenus = 0;
-  ASSERT_NO_FATAL_FAILURE(loadUnitMesh(GetParam(), unit, components, inputGenus));
-  if (IsSkipped())
-    return;
-
   // the defaults find nothing on these meshes (see above): reported, not asserted
   const ActivePoints defaults = computeActivePoints(unit, ActivePointOptions());
   std::cout << "[ active   ] " << GetParam() << " defaults (r 0.025): " << defaults.NumberOfActiveSamples
@@ -118,7 +103,7 @@ TEST_P(ActivePointData, ShapeAwareEnvelopeKeepsTopology)
   EXPECT_EQ(env.Components, components);
   EXPECT_TRUE(env.TopologyWarning.empty()) << env.TopologyWarning;
 
-  expectSoundEnvelope(unit, env.Envelope, options, inputGenus, components);
+  exact::expectSoundCage(unit, env.Envelope, options.clearance(), inputGenus, components, GetParam());
 }
 
 INSTANTIATE_TEST_SUITE_P(Meshes, ActivePointData,
@@ -132,18 +117,12 @@ INSTANTIATE_TEST_SUITE_P(Meshes, ActivePointData,
 // in place (unfoldCrossings) and verified again. So each envelope is accepted without a second,
 // partly uniform extraction (before session 50 each needed one: clearance defects at unmoved
 // midpoints, crossings at lifted ones and the folds). Judged again by the CGAL checker.
-class FirstExtractionData : public ::testing::TestWithParam<std::string>
+class FirstExtractionData : public DataMeshTest
 {
 };
 
 TEST_P(FirstExtractionData, LiftedEnvelopePassesWithoutReExtraction)
 {
-  TriangleMesh unit;
-  int components = 0, inputGenus = 0;
-  ASSERT_NO_FATAL_FAILURE(loadUnitMesh(GetParam(), unit, components, inputGenus));
-  if (IsSkipped())
-    return;
-
   const EnvelopeOptions options;
   const EnvelopeResult env = buildEnvelope(unit, options);
   ASSERT_EQ(env.State, Status::Ok) << env.Message;
@@ -154,7 +133,7 @@ TEST_P(FirstExtractionData, LiftedEnvelopePassesWithoutReExtraction)
   EXPECT_EQ(env.Genus, inputGenus);
   EXPECT_EQ(env.Components, components);
 
-  expectSoundEnvelope(unit, env.Envelope, options, inputGenus, components);
+  exact::expectSoundCage(unit, env.Envelope, options.clearance(), inputGenus, components, GetParam());
 }
 
 INSTANTIATE_TEST_SUITE_P(Meshes, FirstExtractionData,
