@@ -1265,9 +1265,17 @@ public:
         ++r.Collapses;
         ++changes;
         --collapsesLeft;
+        continue;
       }
-      else if (outcome < 0)
+      if (outcome < 0)
         ++r.RejectedCollapses;
+      // a cap (an obtuse corner) that neither a flip nor a collapse mends
+      if (ang[kMax] > 90.0 && tryCapToFoot(f, t[kMax]) > 0)
+      {
+        ++r.Collapses;
+        ++changes;
+        --collapsesLeft;
+      }
     }
     return true;
   }
@@ -1485,6 +1493,108 @@ public:
       for (int f : changed)
         updateBox(f);
       split(b, f1, f2);
+      return 1;
+    }
+    return vetoed ? -1 : 0;
+  }
+
+  /// The remedy for a cap (triangle `cap` with its obtuse corner at `apex`) whose long edge (u, w)
+  /// may not flip and whose short edges may not collapse (each leaves the Hausdorff budget or
+  /// the clearance: anchor_dense's 500-vertex cage kept a 141-degree cap at 14.65 degrees): the
+  /// long edge is split at the apex's foot and the apex collapsed into the split point, i.e. the
+  /// apex moves onto the long edge and the cap and the triangle across (w, u, q) become
+  /// (w, apex, q) and (apex, u, q), in the plane of the one across. The vertex count stays. The
+  /// foot is tried first, then the points at 0.5, 0.35 and 0.65 of the edge. Same checks as a
+  /// collapse (link condition, veto, budget, no component swept) and the smallest angle of the
+  /// region must grow. 1 done, 0 not allowed or no improvement, -1 vetoed.
+  int tryCapToFoot(int cap, int apex)
+  {
+    const Triangle t = T[cap];
+    int k = 0;
+    while (t[k] != apex)
+      ++k;
+    const int u = t[(k + 1) % 3], w = t[(k + 2) % 3];
+    int f1 = -1, f2 = -1, c = -1, q = -1;
+    edgeTriangles(u, w, f1, f2, c, q); // f1 = cap (u, w, apex), f2 = (w, u, q)
+    if (f1 != cap || f2 < 0 || c != apex || q == apex || VT[u].size() <= 3 || VT[w].size() <= 3)
+      return 0;
+    for (int f : VT[apex]) // the new edge (apex, q) must not exist already
+      for (int v : T[f])
+        if (v == q)
+          return 0;
+    std::vector<int> changed;
+    for (int f : VT[apex])
+      if (f != cap)
+        changed.push_back(f);
+    double oldMin = std::min(triangleMinimumAngle(cap), triangleMinimumAngle(f2));
+    for (int f : changed)
+      oldMin = std::min(oldMin, triangleMinimumAngle(f));
+    const Vec3 e = P[w] - P[u];
+    const double foot = e.dot(P[apex] - P[u]) / e.squaredNorm();
+    const double spots[4] = { std::min(0.8, std::max(0.2, foot)), 0.5, 0.35, 0.65 };
+    const Triangle n1{ w, apex, q }, n2{ apex, u, q };
+    const Vec3 across = (P[u] - P[w]).cross(P[q] - P[w]);
+    const double qAcross = std::min(triangleQuality(P[u], P[w], P[apex]), triangleQuality(P[w], P[u], P[q]));
+    bool vetoed = false;
+    LocalChangeScratch& s = work().Change;
+    for (const double spot : spots)
+    {
+      const Vec3 p = P[u] + spot * e;
+      s.Tris.resize(changed.size() + 2);
+      double newMin = 180.0;
+      for (std::size_t i = 0; i < changed.size(); ++i)
+      {
+        const Triangle& old = T[changed[i]];
+        ChangedTriangle& nt = s.Tris[i];
+        for (int j = 0; j < 3; ++j)
+        {
+          nt.Ids[j] = old[j];
+          nt.Pts[j] = old[j] == apex ? p : P[old[j]];
+        }
+        nt.Reference = (P[old[1]] - P[old[0]]).cross(P[old[2]] - P[old[0]]);
+        nt.QualityBefore = triangleQuality(P[old[0]], P[old[1]], P[old[2]]);
+      }
+      for (int i = 0; i < 2; ++i)
+      {
+        const Triangle& n = i == 0 ? n1 : n2;
+        ChangedTriangle& nt = s.Tris[changed.size() + i];
+        for (int j = 0; j < 3; ++j)
+        {
+          nt.Ids[j] = n[j];
+          nt.Pts[j] = n[j] == apex ? p : P[n[j]];
+        }
+        nt.Reference = across;
+        nt.QualityBefore = qAcross;
+      }
+      for (const ChangedTriangle& nt : s.Tris)
+        newMin = std::min(newMin, minimumAngleOf(nt.Pts[0], nt.Pts[1], nt.Pts[2]));
+      if (!(newMin > oldMin + 1e-9))
+        continue;
+      s.Replaced.begin(T.size());
+      s.Replaced.insert(cap);
+      s.Replaced.insert(f2);
+      for (int f : changed)
+        s.Replaced.insert(f);
+      if (!changeAccepted(s) || sweepsComponent(s.Tris, changed, cap, f2))
+      {
+        vetoed = true;
+        continue;
+      }
+      T[cap] = n1;
+      T[f2] = n2;
+      P[apex] = p;
+      auto drop = [&](int v, int f) {
+        auto& l = VT[v];
+        l.erase(std::remove(l.begin(), l.end(), f), l.end());
+      };
+      drop(u, cap); // u keeps f2 (now (apex, u, q)), w keeps cap (now (w, apex, q))
+      drop(w, f2);
+      VT[apex].push_back(f2);
+      VT[q].push_back(cap);
+      updateBox(cap);
+      updateBox(f2);
+      for (int f : changed)
+        updateBox(f);
       return 1;
     }
     return vetoed ? -1 : 0;
