@@ -152,8 +152,13 @@ NestedCageResult generateNestedCages(
     levelOptions.TargetNumberOfVertices = counts[k];
     // Room between this level's parts for the next one (SimplifyOptions::PartClearance, as far as
     // this level's envelope leaves room): the next envelope lies the isovalue c out from each
-    // part (closer only at active points), so parts less than 2c apart fuse in it. 2.2 c, 10%
-    // for the next level's normalization and the extraction. Without it the simplifier lets
+    // part (closer only at active points), so parts less than 2c apart fuse in it, and its grid
+    // resolves the gap between the two offsets only when that is at least a voxel h wide: parts
+    // closer than 2c + h may fuse. (2c + h) x 1.1: 10% for the next level's normalization. (It
+    // was 2.2c until session 51: with the envelope's inside midpoints lifted, the spacing
+    // variant's 100-vertex level below kept its parts 0.029 apart, 2.2c of the next level's
+    // units, and the 40-vertex level's envelope on the c/2 grid fused them: genus 1, one part.)
+    // Without it the simplifier lets
     // parts come as close as the self clearance (c / 16). Measured with two spheres 0.08 apart,
     // levels 400, 100, 40: the 100-vertex level's parts 0.0135 apart without, 0.036 with; the
     // 40-vertex level fused (96 vertices, one part) without, two parts and 40 vertices with.
@@ -162,7 +167,8 @@ NestedCageResult generateNestedCages(
     // bulged differently and the built-in shape's 60-vertex level of core.NestedCages fused its
     // parts); bunny's 2000/500/100 levels 5.1 -> 2.7 s.
     if (k + 1 < L)
-      levelOptions.Simplify.PartClearance = 2.2 * levelOptions.Envelope.IsoValue;
+      levelOptions.Simplify.PartClearance =
+        1.1 * (2.0 * levelOptions.Envelope.IsoValue + levelOptions.Envelope.voxelSize());
     NestedLevel level;
     level.TargetNumberOfVertices = counts[k];
     if (k == 0)
