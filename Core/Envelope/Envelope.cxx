@@ -512,10 +512,19 @@ double traceOut(const TriangleTree& tree, const Vec3& x, const Vec3& u, double d
   return reachedLow;
 }
 
+/// Whether `x` is outside the input (its winding number) and at least `low` away from it.
+bool outsideAtLeast(const TriangleTree& tree, const Vec3& x, double low)
+{
+  Vec3 q;
+  int t = -1;
+  double d = 0.0;
+  return !(tree.closestPoint(x, low, q, t, d) && d < low) && tree.windingNumber(x) < 0.5;
+}
+
 /// Lifted points whose triangles now cross another triangle of the envelope (moving out of a
-/// concave place can push a point through the surface beside it): first lifted again from where
-/// they were (`from`) only to `low` from the input, along the way from their closest input point,
-/// and where that still crosses, put back. `lifted[p]` flags the points still away from `from`;
+/// concave place can push a point through the surface beside it): first moved back towards the
+/// input along the way from their closest input point (which keeps them outside) until they are
+/// only `low` from it, and where that still crosses, put back where they were (`from`). `lifted[p]` flags the points still away from `from`;
 /// `moved` lists every lifted point with its `from`, in increasing point order.
 void uncrossLifted(TriangleMesh& envelope, const TriangleTree& tree, const std::vector<std::pair<int, Vec3>>& moved,
   std::vector<char>& lifted, double c, double low)
@@ -549,18 +558,17 @@ void uncrossLifted(TriangleMesh& envelope, const TriangleTree& tree, const std::
         const std::size_t q = static_cast<std::size_t>(p);
         if (!lifted[q])
           continue;
-        const Vec3& from = fromOf(q);
         Vec3& x = envelope.Points[q];
         Vec3 cp;
         int tq = -1;
         double d = 0.0;
-        if (pass == 0 && tree.closestPoint(from, c, cp, tq, d) && d < low && d > 1e-9 * c)
+        if (pass == 0 && tree.closestPoint(x, 2.0 * c, cp, tq, d) && d > low)
         {
-          x = cp + (from - cp) * (low / d);
+          x = cp + (x - cp) * (low / d);
         }
         else
         {
-          x = from;
+          x = fromOf(q);
           lifted[q] = 0;
         }
         ++undone;
@@ -725,6 +733,21 @@ std::size_t liftCutCorners(
           Vec3 cp;
           int t = -1;
           double d = 0.0;
+          if (tree.windingNumber(x) > 0.5)
+          {
+            // inside the input (the chord cuts through a part or across a sharp edge, as deep as
+            // 0.01 on decimated-max): out through the closest input point, whose way from x is
+            // the outside there, onto the offset
+            if (tree.closestPoint(x, std::numeric_limits<double>::max(), cp, t, d) && d > 1e-9 * c &&
+              outsideAtLeast(tree, cp + (cp - x) * (c / d), traceLow))
+            {
+              x = cp + (cp - x) * (c / d);
+              lifted[i] = 1;
+            }
+            else
+              skipped++;
+            continue;
+          }
           if (!tree.closestPoint(x, c, cp, t, d) || !(d < c))
             continue;
           const std::array<int, 2>& ab = parents[i - before];
@@ -737,9 +760,10 @@ std::size_t liftCutCorners(
             continue;
           }
           // a midpoint whose way away from the input is not the surface's outside: along the normal
+          // (the trace measures distance, not side: a way through a part is not taken)
           const double nl = n.norm();
           const double out = nl > 0.0 ? traceOut(tree, x, n / nl, d, c, traceLow, traceLimit) : -1.0;
-          if (out > 0.0)
+          if (out > 0.0 && tree.windingNumber(x + out * (n / nl)) < 0.5)
           {
             x += out * (n / nl);
             lifted[i] = 1;
@@ -1234,6 +1258,16 @@ EnvelopeResult buildEnvelopeOnce(const TriangleMesh& unitInput, const EnvelopeOp
         // unsplit were measured clear of the input by 1.2 delta)
         lifted.Below = envelope.Points.size();
         lifted.Distance = 1.2 * delta;
+        // the lifting tells inside from outside by the input's winding number (a flood-fill sign
+        // has no tree of its own to ask)
+        tree();
+        if (!inputTree->windingNumbersReady())
+        {
+          const auto tw = std::chrono::steady_clock::now();
+          inputTree->prepareWindingNumbers();
+          if (std::getenv("SDFCAGE_DEBUG_ENVELOPE"))
+            std::fprintf(stderr, "lift: winding numbers prepared in %.4f s\n", seconds(tw));
+        }
         result.LiftedPoints +=
           liftCutCorners(envelope, tree(), c, lifted.Distance, 6, 4 * envelope.Triangles.size() + 1024);
       }
