@@ -1464,12 +1464,7 @@ public:
       }
       if (!(newMin > oldMin + 1e-9))
         continue;
-      s.Replaced.begin(T.size());
-      s.Replaced.insert(f1);
-      s.Replaced.insert(f2);
-      for (int f : changed)
-        s.Replaced.insert(f);
-      if (!changeAccepted(s) || sweepsComponent(s.Tris, changed, f1, f2))
+      if (!regionChangeAccepted(s, changed, f1, f2))
       {
         vetoed = true;
         continue;
@@ -1570,12 +1565,7 @@ public:
         newMin = std::min(newMin, minimumAngleOf(nt.Pts[0], nt.Pts[1], nt.Pts[2]));
       if (!(newMin > oldMin + 1e-9))
         continue;
-      s.Replaced.begin(T.size());
-      s.Replaced.insert(cap);
-      s.Replaced.insert(f2);
-      for (int f : changed)
-        s.Replaced.insert(f);
-      if (!changeAccepted(s) || sweepsComponent(s.Tris, changed, cap, f2))
+      if (!regionChangeAccepted(s, changed, cap, f2))
       {
         vetoed = true;
         continue;
@@ -1598,6 +1588,19 @@ public:
       return 1;
     }
     return vetoed ? -1 : 0;
+  }
+
+  /// The new triangles s.Tris in place of the old ones (changed, f1, f2) of a collapse or a cap's
+  /// move onto its long edge: the veto and the budget (changeAccepted), and no input component
+  /// swept out of the cage (sweepsComponent).
+  bool regionChangeAccepted(LocalChangeScratch& s, const std::vector<int>& changed, int f1, int f2) const
+  {
+    s.Replaced.begin(T.size());
+    s.Replaced.insert(f1);
+    s.Replaced.insert(f2);
+    for (int f : changed)
+      s.Replaced.insert(f);
+    return changeAccepted(s) && !sweepsComponent(s.Tris, changed, f1, f2);
   }
 
   /// Would replacing the old triangles (changed, f1, f2) by the new ones s sweep an input
