@@ -47,10 +47,14 @@ struct PolygonMesh
 /// Triangle t's normal scaled by twice its area (the cross product of its edges from t[0]):
 /// outward on an outward-oriented mesh; summed over a point's or an edge's triangles it gives the
 /// area-weighted normal there.
+inline Vec3 areaNormal(const std::vector<Vec3>& points, const Triangle& t)
+{
+  const Vec3& a = points[static_cast<std::size_t>(t[0])];
+  return (points[static_cast<std::size_t>(t[1])] - a).cross(points[static_cast<std::size_t>(t[2])] - a);
+}
 inline Vec3 areaNormal(const TriangleMesh& mesh, const Triangle& t)
 {
-  const Vec3& a = mesh.Points[static_cast<std::size_t>(t[0])];
-  return (mesh.Points[static_cast<std::size_t>(t[1])] - a).cross(mesh.Points[static_cast<std::size_t>(t[2])] - a);
+  return areaNormal(mesh.Points, t);
 }
 
 /// Signed volume enclosed by a closed mesh (positive when outward oriented).

@@ -311,7 +311,7 @@ public:
       const Triangle& t = T[f];
       Lo[f] = P[t[0]].cwiseMin(P[t[1]]).cwiseMin(P[t[2]]);
       Hi[f] = P[t[0]].cwiseMax(P[t[1]]).cwiseMax(P[t[2]]);
-      area += 0.5 * (P[t[1]] - P[t[0]]).cross(P[t[2]] - P[t[0]]).norm();
+      area += 0.5 * areaNormal(P, t).norm();
     }
     // cells of about two mean edges (the edge of an equilateral triangle of the mean area)
     const double meanEdge = std::sqrt(4.0 * area / std::max<std::size_t>(1, T.size()) / std::sqrt(3.0));
@@ -1435,7 +1435,7 @@ public:
     // would otherwise cut into the clearance) the midpoint lifted along the region's normal
     Vec3 normal = Vec3::Zero();
     for (int f : changed)
-      normal += (P[T[f][1]] - P[T[f][0]]).cross(P[T[f][2]] - P[T[f][0]]);
+      normal += areaNormal(P, T[f]);
     if (normal.norm() > 0)
       normal.normalize();
     const double len = (P[b] - P[a]).norm();
@@ -1452,14 +1452,10 @@ public:
       for (std::size_t i = 0; i < changed.size(); ++i)
       {
         const Triangle& old = T[changed[i]];
+        Triangle ids = old;
+        std::replace(ids.begin(), ids.end(), b, a);
         ChangedTriangle& nt = s.Tris[i];
-        for (int k = 0; k < 3; ++k)
-        {
-          nt.Ids[k] = old[k] == b ? a : old[k];
-          nt.Pts[k] = nt.Ids[k] == a ? p : P[nt.Ids[k]];
-        }
-        nt.Reference = (P[old[1]] - P[old[0]]).cross(P[old[2]] - P[old[0]]);
-        nt.QualityBefore = triangleQuality(P[old[0]], P[old[1]], P[old[2]]);
+        fillChanged(nt, ids, a, p, old);
         newMin = std::min(newMin, minimumAngleOf(nt.Pts[0], nt.Pts[1], nt.Pts[2]));
       }
       if (!(newMin > oldMin + 1e-9))
@@ -1528,7 +1524,7 @@ public:
     const double foot = e.dot(P[apex] - P[u]) / e.squaredNorm();
     const double spots[4] = { std::min(0.8, std::max(0.2, foot)), 0.5, 0.35, 0.65 };
     const Triangle n1{ w, apex, q }, n2{ apex, u, q };
-    const Vec3 across = (P[u] - P[w]).cross(P[q] - P[w]);
+    const Vec3 across = areaNormal(P, Triangle{ w, u, q });
     const double qAcross = std::min(triangleQuality(P[u], P[w], P[apex]), triangleQuality(P[w], P[u], P[q]));
     bool vetoed = false;
     LocalChangeScratch& s = work().Change;
@@ -1538,29 +1534,9 @@ public:
       s.Tris.resize(changed.size() + 2);
       double newMin = 180.0;
       for (std::size_t i = 0; i < changed.size(); ++i)
-      {
-        const Triangle& old = T[changed[i]];
-        ChangedTriangle& nt = s.Tris[i];
-        for (int j = 0; j < 3; ++j)
-        {
-          nt.Ids[j] = old[j];
-          nt.Pts[j] = old[j] == apex ? p : P[old[j]];
-        }
-        nt.Reference = (P[old[1]] - P[old[0]]).cross(P[old[2]] - P[old[0]]);
-        nt.QualityBefore = triangleQuality(P[old[0]], P[old[1]], P[old[2]]);
-      }
-      for (int i = 0; i < 2; ++i)
-      {
-        const Triangle& n = i == 0 ? n1 : n2;
-        ChangedTriangle& nt = s.Tris[changed.size() + i];
-        for (int j = 0; j < 3; ++j)
-        {
-          nt.Ids[j] = n[j];
-          nt.Pts[j] = n[j] == apex ? p : P[n[j]];
-        }
-        nt.Reference = across;
-        nt.QualityBefore = qAcross;
-      }
+        fillChanged(s.Tris[i], T[changed[i]], apex, p, T[changed[i]]);
+      fillChanged(s.Tris[changed.size()], n1, apex, p, across, qAcross);
+      fillChanged(s.Tris[changed.size() + 1], n2, apex, p, across, qAcross);
       for (const ChangedTriangle& nt : s.Tris)
         newMin = std::min(newMin, minimumAngleOf(nt.Pts[0], nt.Pts[1], nt.Pts[2]));
       if (!(newMin > oldMin + 1e-9))
@@ -1588,6 +1564,25 @@ public:
       return 1;
     }
     return vetoed ? -1 : 0;
+  }
+
+  /// nt: the triangle `ids` with vertex `moved` at p, judged against the normal `reference` and
+  /// the quality `qualityBefore` of what it replaces (a collapse's and a cap remedy's new region).
+  void fillChanged(
+    ChangedTriangle& nt, const Triangle& ids, int moved, const Vec3& p, const Vec3& reference, double qualityBefore) const
+  {
+    for (int k = 0; k < 3; ++k)
+    {
+      nt.Ids[k] = ids[k];
+      nt.Pts[k] = ids[k] == moved ? p : P[ids[k]];
+    }
+    nt.Reference = reference;
+    nt.QualityBefore = qualityBefore;
+  }
+  /// The same, judged against the old triangle `old` it replaces.
+  void fillChanged(ChangedTriangle& nt, const Triangle& ids, int moved, const Vec3& p, const Triangle& old) const
+  {
+    fillChanged(nt, ids, moved, p, areaNormal(P, old), triangleQuality(P[old[0]], P[old[1]], P[old[2]]));
   }
 
   /// The new triangles s.Tris in place of the old ones (changed, f1, f2) of a collapse or a cap's
