@@ -154,7 +154,10 @@ NestedCageResult generateNestedCages(
     // this level's envelope leaves room): the next envelope lies the isovalue c out from each
     // part (closer only at active points), so parts less than 2c apart fuse in it, and its grid
     // resolves the gap between the two offsets only when that is at least a voxel h wide: parts
-    // closer than 2c + h may fuse. (2c + h) x 1.1: 10% for the next level's normalization. (It
+    // closer than 2c + h may fuse. h is the requested voxel, not the coarse grid the next level
+    // tries first: a coarse envelope that fuses parts fails the topology check and the level
+    // falls back to the requested grid, which must resolve the gap. (2c + h) x 1.1: 10% for the
+    // next level's normalization. (It
     // was 2.2c until session 51: with the envelope's inside midpoints lifted, the spacing
     // variant's 100-vertex level below kept its parts 0.029 apart, 2.2c of the next level's
     // units, and the 40-vertex level's envelope on the c/2 grid fused them: genus 1, one part.)
