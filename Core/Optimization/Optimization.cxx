@@ -1568,8 +1568,8 @@ public:
 
   /// nt: the triangle `ids` with vertex `moved` at p, judged against the normal `reference` and
   /// the quality `qualityBefore` of what it replaces (a collapse's and a cap remedy's new region).
-  void fillChanged(
-    ChangedTriangle& nt, const Triangle& ids, int moved, const Vec3& p, const Vec3& reference, double qualityBefore) const
+  void fillChanged(ChangedTriangle& nt, const Triangle& ids, int moved, const Vec3& p, const Vec3& reference,
+    double qualityBefore) const
   {
     for (int k = 0; k < 3; ++k)
     {
