@@ -128,6 +128,11 @@ struct EnvelopeOptions
   /// surface (its area / h^2) is not tried. Needs active points and the flood-fill rule. 0 = off.
   int MaximumTopologyRepairs = 2;
   double MaximumRepairSurfaceVoxels = 2.0e7;
+  /// Set by the topology repair's first round (0 = off): its finer grid is exact only within
+  /// this many coarse voxels of the gaps the grid twice as coarse may fuse (computeIsosurface's
+  /// LocalExactField), elsewhere the coarse field interpolated. Needs active points and the
+  /// flood-fill rule.
+  int LocalExactDilation = 0;
   /// Fail (Status::TopologyChanged, no envelope) instead of accepting an envelope whose genus
   /// or number of parts differs from the closed input's after the repairs.
   bool RequireTopology = false;
@@ -176,6 +181,7 @@ struct EnvelopeResult
   std::size_t NumberOfActivePoints = 0;  ///< input points flagged active
   std::size_t NumberOfActiveSamples = 0; ///< size of the active set A (samples)
   std::size_t AmplifiedVoxels = 0;       ///< voxels where phi > 1.001
+  std::size_t ExactVoxels = 0;           ///< a repair round's voxels computed exactly (LocalExactDilation)
   std::size_t FieldTriangles = 0;        ///< triangles the kept envelope's field came from (ClusteredField)
   double ActivePointSeconds = 0.0;       ///< active points + g_A
   double AmplificationSeconds = 0.0;     ///< xi -> phi xi on the grid (included in DistanceFieldSeconds)

@@ -10,6 +10,7 @@
 #include <openvdb/tools/MeshToVolume.h>
 #include <openvdb/tools/Morphology.h>
 #include <openvdb/tools/Prune.h>
+#include <openvdb/tools/SignedFloodFill.h>
 #include <openvdb/tools/VolumeToMesh.h>
 #include <openvdb/tree/LeafManager.h>
 
@@ -19,6 +20,7 @@
 #include <tbb/parallel_sort.h>
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstdint>
@@ -531,6 +533,266 @@ std::size_t markAround(const std::vector<Vec3>& points, double voxelSize, int ra
   return added;
 }
 
+/// The side of a closed, consistently oriented mesh a point is on, from its closest point: the
+/// angle-weighted pseudo-normal of the closest feature (face, edge or vertex) points to the
+/// outside (Baerentzen and Aanaes, "Signed distance computation using the angle weighted
+/// pseudonormal", 2005). Written here: OpenVDB signs whole grids by flood fill, and a field
+/// computed only near some points has no closed band to fill from.
+class PseudoNormalSign
+{
+public:
+  explicit PseudoNormalSign(const TriangleMesh& mesh)
+    : M(mesh)
+    , Face(mesh.Triangles.size(), Vec3::Zero())
+    , Vertex(mesh.Points.size(), Vec3::Zero())
+    , Across(3 * mesh.Triangles.size(), -1)
+  {
+    std::vector<std::pair<std::uint64_t, int>> edges;
+    edges.reserve(3 * mesh.Triangles.size());
+    for (std::size_t f = 0; f < mesh.Triangles.size(); ++f)
+    {
+      const Triangle& t = mesh.Triangles[f];
+      const Vec3 n = areaNormal(mesh, t);
+      const double len = n.norm();
+      Face[f] = len > 0 ? Vec3(n / len) : Vec3::Zero();
+      for (int k = 0; k < 3; ++k)
+      {
+        const Vec3& p = mesh.Points[t[k]];
+        const Vec3 u = mesh.Points[t[(k + 1) % 3]] - p, w = mesh.Points[t[(k + 2) % 3]] - p;
+        Vertex[t[k]] += std::atan2(u.cross(w).norm(), u.dot(w)) * Face[f];
+        const std::uint32_t a = static_cast<std::uint32_t>(std::min(t[k], t[(k + 1) % 3]));
+        const std::uint32_t b = static_cast<std::uint32_t>(std::max(t[k], t[(k + 1) % 3]));
+        edges.emplace_back((std::uint64_t(a) << 32) | b, static_cast<int>(3 * f + k));
+      }
+    }
+    tbb::parallel_sort(edges.begin(), edges.end());
+    for (std::size_t i = 0; i + 1 < edges.size(); ++i)
+      if (edges[i].first == edges[i + 1].first)
+      {
+        Across[static_cast<std::size_t>(edges[i].second)] = edges[i + 1].second / 3;
+        Across[static_cast<std::size_t>(edges[i + 1].second)] = edges[i].second / 3;
+      }
+  }
+
+  const Vec3& faceNormal(int f) const { return Face[static_cast<std::size_t>(f)]; }
+
+  /// x's closest point on the mesh is cp, on triangle f: is x outside?
+  bool outside(const Vec3& x, int f, const Vec3& cp) const
+  {
+    const Triangle& t = M.Triangles[static_cast<std::size_t>(f)];
+    const Vec3 &a = M.Points[t[0]], &b = M.Points[t[1]], &c = M.Points[t[2]];
+    const double area = areaNormal(M, t).norm();
+    Vec3 n = Face[static_cast<std::size_t>(f)];
+    if (area > 0)
+    {
+      // barycentric weights of cp: a weight near 0 puts it on the opposite edge
+      const double w[3] = { (b - cp).cross(c - cp).norm() / area, (c - cp).cross(a - cp).norm() / area,
+        (a - cp).cross(b - cp).norm() / area };
+      const double eps = 1e-7;
+      int zeros = 0, zero = -1, nonzero = -1;
+      for (int k = 0; k < 3; ++k)
+        if (w[k] < eps)
+        {
+          ++zeros;
+          zero = k;
+        }
+        else
+          nonzero = k;
+      if (zeros >= 2)
+        n = Vertex[static_cast<std::size_t>(t[nonzero])]; // at a corner
+      else if (zeros == 1)
+      {
+        // on the edge opposite corner `zero`: edge k runs from corner k to k + 1
+        const int across = Across[3 * static_cast<std::size_t>(f) + static_cast<std::size_t>((zero + 1) % 3)];
+        if (across >= 0)
+          n = Face[static_cast<std::size_t>(f)] + Face[static_cast<std::size_t>(across)];
+      }
+    }
+    return (x - cp).dot(n) > 0;
+  }
+
+private:
+  const TriangleMesh& M;
+  std::vector<Vec3> Face, Vertex;
+  std::vector<int> Across; ///< the triangle across edge k of f (3 f + k), -1 on a border
+};
+
+/// computeIsosurface's field with a LocalExactField: the amplified field of the grid twice as
+/// coarse (OpenVDB's, from `coarse` and its closest triangles `coarseClosest`, positions in
+/// `order`), interpolated onto the grid of `voxelSize`, and computed exactly (a query of
+/// local.Tree per voxel, signed by the pseudo-normal) within local.Dilation coarse voxels of a
+/// facing gap.
+/// `noAdapt` gets the voxels the amplification keeps uniform (as amplify marks them). Returns
+/// the grid (nullptr when cancelled); `exact` counts the voxels computed exactly.
+openvdb::FloatGrid::Ptr localExactField(const openvdb::FloatGrid& coarse, const openvdb::BoolTree& coarseMask,
+  const openvdb::Int32Grid& coarseClosest, const std::vector<int>& order, const ActivePoints& amp,
+  const LocalExactField& local, double voxelSize, double iso, float background, openvdb::BoolTree& noAdapt,
+  std::size_t& exact, std::size_t& amplified, Progress* progress)
+{
+  using LeafT = openvdb::FloatTree::LeafNodeType;
+  // the fine leaves under the coarse ones: each coarse leaf of 8^3 voxels covers 2^3 fine leaves
+  std::vector<const openvdb::FloatTree::LeafNodeType*> coarseLeaves;
+  coarse.tree().getNodes(coarseLeaves);
+  std::vector<std::unique_ptr<LeafT>> fine(8 * coarseLeaves.size());
+  std::vector<std::unique_ptr<openvdb::BoolTree::LeafNodeType>> fineMask(fine.size());
+  const PseudoNormalSign sign(amp.Surface);
+  // The gaps the coarse grid may fuse: neighbouring coarse voxels whose closest points lie on
+  // surfaces facing each other across the space between them (each one's normal points at the
+  // other's closest point; inside a thin part they point away from each other). Every voxel
+  // within `Dilation` coarse voxels of one is exact.
+  openvdb::BoolTree gaps(false);
+  {
+    using CoarseLeaf = openvdb::FloatTree::LeafNodeType;
+    tbb::enumerable_thread_specific<std::vector<openvdb::Coord>> found;
+    const int triangles = static_cast<int>(amp.Surface.Triangles.size());
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, coarseLeaves.size(), 8),
+      [&](const tbb::blocked_range<std::size_t>& r) {
+        auto idx = coarseClosest.getConstAccessor();
+        auto values = coarse.getConstAccessor();
+        auto& mine = found.local();
+        const auto closestAt = [&](const openvdb::Coord& ijk, Vec3& cp, Vec3& n) {
+          const int position = idx.getValue(ijk);
+          if (position < 0 || position >= static_cast<int>(order.size()))
+            return false;
+          const int t = order[static_cast<std::size_t>(position)];
+          if (t < 0 || t >= triangles)
+            return false;
+          const Triangle& tri = amp.Surface.Triangles[static_cast<std::size_t>(t)];
+          const Vec3 x(ijk.x() * 2.0 * voxelSize, ijk.y() * 2.0 * voxelSize, ijk.z() * 2.0 * voxelSize);
+          cp = closestPointOnTriangle(x, amp.Surface.Points[tri[0]], amp.Surface.Points[tri[1]], amp.Surface.Points[tri[2]]);
+          n = sign.faceNormal(t);
+          return true;
+        };
+        for (std::size_t l = r.begin(); l != r.end(); ++l)
+        {
+          const CoarseLeaf& cl = *coarseLeaves[l];
+          for (auto it = cl.cbeginValueOn(); it; ++it)
+          {
+            const openvdb::Coord ijk = it.getCoord();
+            Vec3 cp, n;
+            if (!closestAt(ijk, cp, n))
+              continue;
+            for (int axis = 0; axis < 3; ++axis)
+            {
+              openvdb::Coord next = ijk;
+              next[axis] += 1;
+              if (!values.isValueOn(next))
+                continue;
+              Vec3 cq, m;
+              if (!closestAt(next, cq, m))
+                continue;
+              if (n.dot(m) < 0 && (cq - cp).dot(n) > 0 && (cp - cq).dot(m) > 0)
+              {
+                mine.push_back(ijk);
+                mine.push_back(next);
+              }
+            }
+          }
+        }
+      });
+    for (const auto& list : found)
+      for (const openvdb::Coord& c : list)
+        gaps.setValueOn(c, true);
+    if (std::getenv("SDFCAGE_DEBUG_ENVELOPE"))
+      std::fprintf(stderr, "local exact field: %zu coarse voxels at facing gaps\n", std::size_t(gaps.activeVoxelCount()));
+    if (!gaps.empty())
+      openvdb::tools::dilateActiveValues(gaps, local.Dilation, openvdb::tools::NN_FACE_EDGE_VERTEX, openvdb::tools::IGNORE_TILES);
+  }
+  const double noAdaptPhi = 1.0 + amp.AdaptivityOffFraction * (amp.Alpha - 1.0);
+  const float maxAmplified = static_cast<float>(iso + 2.0 * voxelSize);
+  const double limit = static_cast<double>(background); // the band's width: beyond it, the background
+  std::atomic<std::size_t> exactCount{ 0 }, amplifiedCount{ 0 };
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, coarseLeaves.size(), 8),
+    [&](const tbb::blocked_range<std::size_t>& r) {
+      auto acc = coarse.getConstAccessor();
+      openvdb::tree::ValueAccessor<const openvdb::BoolTree> maskAcc(coarseMask);
+      openvdb::tree::ValueAccessor<const openvdb::BoolTree> gapAcc(gaps);
+      std::size_t e = 0, a = 0;
+      for (std::size_t l = r.begin(); l != r.end(); ++l)
+      {
+        if (progressCancelled(progress))
+          return;
+        const LeafT& cl = *coarseLeaves[l];
+        const openvdb::Coord co = cl.origin();
+        for (int s = 0; s < 8; ++s)
+        {
+          const openvdb::Coord fo(2 * co.x() + 8 * (s & 1), 2 * co.y() + 8 * ((s >> 1) & 1), 2 * co.z() + 8 * (s >> 2));
+          auto leaf = std::make_unique<LeafT>(fo, background, false);
+          auto mask = std::make_unique<openvdb::BoolTree::LeafNodeType>(fo, false, false);
+          bool any = false;
+          for (openvdb::Index n = 0; n < LeafT::SIZE; ++n)
+          {
+            const openvdb::Coord ijk = LeafT::offsetToLocalCoord(n) + fo;
+            const openvdb::Coord parent(ijk.x() >> 1, ijk.y() >> 1, ijk.z() >> 1);
+            const Vec3 x(ijk.x() * voxelSize, ijk.y() * voxelSize, ijk.z() * voxelSize);
+            // near a gap every voxel is exact, also where the coarse grid's band has none (the
+            // inside of a gap the coarse grid fused: a crossing next to an inactive voxel would
+            // leave the extraction a crack)
+            const bool exactHere = gapAcc.isValueOn(parent);
+            if (!exactHere && !cl.isValueOn(parent))
+            {
+              // off: its sign for the flood fill, from the coarse grid
+              leaf->setValueOnly(n, cl.getValue(parent) < 0 ? -background : background);
+              continue;
+            }
+            any = true;
+            float v = static_cast<float>(openvdb::tools::BoxSampler::sample(
+              acc, openvdb::Vec3R(0.5 * ijk.x(), 0.5 * ijk.y(), 0.5 * ijk.z())));
+            bool keepUniform = maskAcc.isValueOn(parent);
+            if (exactHere)
+            {
+              ++e;
+              Vec3 cp;
+              int t = -1;
+              double d = 0.0;
+              if (!local.Tree->closestPoint(x, limit, cp, t, d))
+                v = v < 0 ? -background : background;
+              else
+              {
+                double signedD = sign.outside(x, t, cp) ? d : -d;
+                keepUniform = false;
+                if (signedD > 0 && signedD <= maxAmplified)
+                {
+                  const double phi = amp.amplificationAt(t, cp, d);
+                  a += phi > 1.001 ? 1 : 0;
+                  keepUniform = phi > noAdaptPhi;
+                  signedD *= phi;
+                }
+                v = static_cast<float>(std::max(-limit, std::min(limit, signedD)));
+              }
+            }
+            leaf->setValueOn(n, v);
+            if (keepUniform)
+              mask->setValueOn(n, true);
+          }
+          if (any)
+          {
+            fine[8 * l + static_cast<std::size_t>(s)] = std::move(leaf);
+            fineMask[8 * l + static_cast<std::size_t>(s)] = std::move(mask);
+          }
+        }
+      }
+      exactCount += e;
+      amplifiedCount += a;
+    });
+  if (progressCancelled(progress))
+    return nullptr;
+  auto grid = openvdb::FloatGrid::create(background);
+  grid->setTransform(openvdb::math::Transform::createLinearTransform(voxelSize));
+  grid->setGridClass(openvdb::GRID_LEVEL_SET);
+  for (std::size_t i = 0; i < fine.size(); ++i)
+    if (fine[i])
+    {
+      grid->tree().addLeaf(fine[i].release());
+      noAdapt.addLeaf(fineMask[i].release());
+    }
+  // the inside beyond the band (tiles and untouched leaves' voxels) negative, as meshToVolume's
+  openvdb::tools::signedFloodFill(grid->tree());
+  exact = exactCount.load();
+  amplified = amplifiedCount.load();
+  return grid;
+}
+
 } // namespace
 
 long long abandonedExtractionCount()
@@ -771,7 +1033,8 @@ openvdb::FloatGrid::Ptr unsignedBandField(const TriangleMesh& mesh, const Triang
 
 IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSize, double iso, bool keepField,
   Progress* progress, const std::vector<double>& adaptivities, const ActivePoints* amplification,
-  const SurfaceJudge* judge, int maxRepairs, SignMode sign, const TriangleTree* windingTree, bool clusteredField)
+  const SurfaceJudge* judge, int maxRepairs, SignMode sign, const TriangleTree* windingTree, bool clusteredField,
+  const LocalExactField* local)
 {
   std::call_once(vdbInit, []() { openvdb::initialize(); });
   if (amplification && amplification->empty())
@@ -882,9 +1145,38 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
     }
   }
   const CancellableMeshAdapter adapter(points, tris, progress, &expanding);
+  const bool localField = local && amplification && !unsignedField && !ownBand && local->Tree &&
+    local->Dilation > 0;
+  openvdb::BoolTree::Ptr localMask;
   try
   {
-    if (ownBand)
+    if (localField)
+    {
+      // the grid twice as coarse (index space: half the coordinates), amplified on its own voxels
+      std::vector<openvdb::Vec3s> coarsePoints(points.size());
+      for (std::size_t i = 0; i < points.size(); ++i)
+        coarsePoints[i] = points[i] * 0.5f;
+      const CancellableMeshAdapter coarseAdapter(coarsePoints, tris, progress, &expanding);
+      const double coarseVoxel = 2.0 * voxelSize;
+      const auto coarseTransform = openvdb::math::Transform::createLinearTransform(coarseVoxel);
+      const float coarseBand = static_cast<float>(std::ceil(iso / coarseVoxel) + 1.0);
+      openvdb::FloatGrid::Ptr coarse = openvdb::tools::meshToVolume<openvdb::FloatGrid>(
+        sdfInterrupter, coarseAdapter, *coarseTransform, coarseBand, 1.0f, 0, closestTriangle.get());
+      if (coarse && !progressCancelled(progress))
+      {
+        openvdb::BoolTree coarseMask(coarse->tree(), false, openvdb::TopologyCopy());
+        amplify(*coarse, *closestTriangle, order, *amplification, coarseVoxel,
+          static_cast<float>(iso + 2.0 * coarseVoxel), coarseMask, progress);
+        localMask.reset(new openvdb::BoolTree(false));
+        grid = localExactField(*coarse, coarseMask, *closestTriangle, order, *amplification, *local, voxelSize, iso,
+          static_cast<float>(exteriorBand * voxelSize), *localMask, out.ExactVoxels, out.AmplifiedVoxels, progress);
+      }
+      closestTriangle.reset();
+      if (std::getenv("SDFCAGE_DEBUG_ENVELOPE"))
+        std::fprintf(stderr, "local exact field: %zu of %zu voxels exact, %.4f s\n", out.ExactVoxels,
+          grid ? std::size_t(grid->activeVoxelCount()) : 0, seconds(t0));
+    }
+    else if (ownBand)
     {
       out.FieldTriangles = unitMesh.Triangles.size();
       grid = unsignedBandField(unitMesh, *windingTree, voxelSize, static_cast<int>(exteriorBand), progress);
@@ -1101,7 +1393,12 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
   // close to the input there, merged polygons would cut into the clearance) and, after a failed
   // judgement, around the triangles the judge points at.
   openvdb::BoolTree::Ptr noAdapt(new openvdb::BoolTree(false));
-  if (amplification)
+  if (localMask)
+  {
+    noAdapt = localMask; // amplified by localExactField
+    openvdb::tools::dilateActiveValues(*noAdapt, 1);
+  }
+  else if (amplification)
   {
     // xi^ = phi xi (eq. 2–3) wherever the isosurface xi^ = iso can lie or be interpolated from:
     // phi >= 1, so only where xi <= iso (plus a voxel for the interpolation).

@@ -28,6 +28,7 @@ struct IsosurfaceOutput
   double IsosurfaceSeconds = 0.0; ///< the extractions and the display field (not the judge's time)
   std::size_t ActiveVoxels = 0;
   std::size_t AmplifiedVoxels = 0;    ///< voxels whose value phi changed by more than 1e-3
+  std::size_t ExactVoxels = 0;        ///< with a LocalExactField: the voxels computed exactly near its sites
   double AmplificationSeconds = 0.0;  ///< xi -> phi xi on the grid (part of DistanceFieldSeconds)
   double WindingSeconds = 0.0;        ///< the winding-number sign (part of DistanceFieldSeconds)
   std::size_t WindingEvaluations = 0; ///< voxels whose winding number was evaluated
@@ -61,10 +62,24 @@ using SurfaceJudge = std::function<bool(const TriangleMesh& surface, double adap
 /// `windingTree` (the input's tree, prepareWindingNumbers() done) gives |w| > 1/2. The deep inside
 /// beyond the band reads as outside then and yields inward-facing pockets, which the envelope
 /// removes with the others.
+///
+/// `local` (with amplification and the flood-fill sign only): the field is exact only near the
+/// gaps the grid twice as coarse may fuse: neighbouring coarse voxels whose closest points lie
+/// on surfaces facing each other across the space between them, dilated by local->Dilation
+/// coarse voxels. There every voxel is a query of local->Tree (over amplification->Surface),
+/// signed by the angle-weighted pseudo-normal of its closest feature. Elsewhere the field is the
+/// amplified field of the coarse grid, trilinearly interpolated: the finer grid only resolves
+/// the same surface more finely there (the envelope's points are projected onto the exact
+/// amplified offset and the envelope is verified, as always).
+struct LocalExactField
+{
+  int Dilation = 0; ///< exact within this many coarse voxels of a facing gap
+  const TriangleTree* Tree = nullptr;
+};
 IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSize, double iso, bool keepField,
   Progress* progress, const std::vector<double>& adaptivities = { 0.0 }, const ActivePoints* amplification = nullptr,
   const SurfaceJudge* judge = nullptr, int maxRepairs = 3, SignMode sign = SignMode::FloodFill,
-  const TriangleTree* windingTree = nullptr, bool clusteredField = false);
+  const TriangleTree* windingTree = nullptr, bool clusteredField = false, const LocalExactField* local = nullptr);
 
 /// How many isosurface extractions a cancel has abandoned since the process started (each ends
 /// on its own thread and frees its memory; the process waits for them at exit). For tests and
