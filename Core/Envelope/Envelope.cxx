@@ -375,7 +375,7 @@ std::size_t projectOntoAmplifiedOffset(
         const int a = t[k], b = t[(k + 1) % 3];
         if (a < b && static_cast<std::size_t>(b) >= firstNew && amplified[a] && amplified[b] &&
           (envelope.Points[a] - envelope.Points[b]).squaredNorm() > m2)
-          candidates.push_back((static_cast<std::uint64_t>(a) << 32) | static_cast<std::uint32_t>(b));
+          candidates.push_back(edgeKey(a, b));
       }
     std::sort(candidates.begin(), candidates.end());
     candidates.erase(std::unique(candidates.begin(), candidates.end()), candidates.end());
@@ -394,8 +394,7 @@ std::size_t projectOntoAmplifiedOffset(
         }
       });
     const std::size_t created = splitEdges(envelope, [&](int a, int b) {
-      const std::uint64_t key =
-        (static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint32_t>(std::max(a, b));
+      const std::uint64_t key = edgeKey(a, b);
       const auto it = std::lower_bound(candidates.begin(), candidates.end(), key);
       return it != candidates.end() && *it == key && sags[it - candidates.begin()] != 0;
     });
@@ -1690,6 +1689,16 @@ std::vector<Vec3> spreadSites(const std::vector<Vec3>& sites, std::size_t count,
   return out;
 }
 
+/// Adds the stage times of an envelope built and not kept (a repair round, a first envelope
+/// built again verified) to those of the one kept: the timings count every build.
+void addStageSeconds(EnvelopeResult& to, const EnvelopeResult& from)
+{
+  to.DistanceFieldSeconds += from.DistanceFieldSeconds;
+  to.IsosurfaceSeconds += from.IsosurfaceSeconds;
+  to.VerificationSeconds += from.VerificationSeconds;
+  to.ActivePointSeconds += from.ActivePointSeconds;
+}
+
 } // namespace
 
 EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOptions& options, Progress* progress,
@@ -1706,10 +1715,7 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
       return;
     }
     EnvelopeResult again = buildEnvelopeOnce(unitInput, options, progress, progressEnd, inputClosed);
-    again.DistanceFieldSeconds += r.DistanceFieldSeconds;
-    again.IsosurfaceSeconds += r.IsosurfaceSeconds;
-    again.VerificationSeconds += r.VerificationSeconds;
-    again.ActivePointSeconds += r.ActivePointSeconds;
+    addStageSeconds(again, r);
     again.GapSites = std::move(r.GapSites);
     r = std::move(again);
   };
@@ -1867,10 +1873,7 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
           << (r.State != Status::Ok ? std::string("not verified") : "genus " + std::to_string(r.Genus))
           << "; on the exact grid";
       EnvelopeResult exact = buildEnvelopeOnce(unitInput, o, progress, progressEnd, inputClosed ? 1 : 0);
-      exact.DistanceFieldSeconds += r.DistanceFieldSeconds;
-      exact.IsosurfaceSeconds += r.IsosurfaceSeconds;
-      exact.VerificationSeconds += r.VerificationSeconds;
-      exact.ActivePointSeconds += r.ActivePointSeconds;
+      addStageSeconds(exact, r);
       r = std::move(exact);
     }
     else if (localOptions.LocalExactDilation > 0)
@@ -1888,13 +1891,7 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
     char took[32];
     std::snprintf(took, sizeof took, " (%.2f s)", roundSeconds);
     log << ": " << r.NumberOfActiveSamples << " active samples (" << r.GapSites.size() << " by the gap rule), ";
-    // a round's stages count in the timings whether or not its envelope is kept
-    const auto addStageSeconds = [](EnvelopeResult& to, const EnvelopeResult& from) {
-      to.DistanceFieldSeconds += from.DistanceFieldSeconds;
-      to.IsosurfaceSeconds += from.IsosurfaceSeconds;
-      to.VerificationSeconds += from.VerificationSeconds;
-      to.ActivePointSeconds += from.ActivePointSeconds;
-    };
+    // (a round's stages count in the timings whether or not its envelope is kept)
     if (r.State != Status::Ok)
     {
       log << "not verified" << took;
