@@ -89,15 +89,17 @@ private:
 /// used to throw instead, which stopped sooner but lost the nodes made so far in the iteration:
 /// OpenVDB holds them by raw pointers in its parallel_reduce bodies until the iteration's end, a
 /// few megabytes per cancel.) The grid is then wrong, and thrown away: the caller sees the cancel.
+/// `scale` maps the points' index space to the grid's (0.5 for a grid twice as coarse).
 class CancellableMeshAdapter
 {
 public:
   CancellableMeshAdapter(const std::vector<openvdb::Vec3s>& points, const std::vector<openvdb::Vec3I>& triangles,
-    Progress* progress, const std::atomic<bool>* expanding)
+    Progress* progress, const std::atomic<bool>* expanding, double scale = 1.0)
     : Points(points)
     , Triangles(triangles)
     , P(progress)
     , Expanding(expanding)
+    , Scale(scale)
   {
   }
   std::size_t polygonCount() const { return Triangles.size(); }
@@ -116,9 +118,9 @@ public:
       }
     }
     const openvdb::Vec3s& p = Points[Triangles[n][static_cast<int>(v)]];
-    pos[0] = double(p[0]);
-    pos[1] = double(p[1]);
-    pos[2] = double(p[2]);
+    pos[0] = Scale * double(p[0]);
+    pos[1] = Scale * double(p[1]);
+    pos[2] = Scale * double(p[2]);
   }
 
 private:
@@ -126,6 +128,7 @@ private:
   const std::vector<openvdb::Vec3I>& Triangles;
   Progress* P;
   const std::atomic<bool>* Expanding;
+  const double Scale;
   mutable std::atomic<bool> Stopped{ false };
 };
 
@@ -533,90 +536,6 @@ std::size_t markAround(const std::vector<Vec3>& points, double voxelSize, int ra
   return added;
 }
 
-/// The side of a closed, consistently oriented mesh a point is on, from its closest point: the
-/// angle-weighted pseudo-normal of the closest feature (face, edge or vertex) points to the
-/// outside (Baerentzen and Aanaes, "Signed distance computation using the angle weighted
-/// pseudonormal", 2005). Written here: OpenVDB signs whole grids by flood fill, and a field
-/// computed only near some points has no closed band to fill from.
-class PseudoNormalSign
-{
-public:
-  explicit PseudoNormalSign(const TriangleMesh& mesh)
-    : M(mesh)
-    , Face(mesh.Triangles.size(), Vec3::Zero())
-    , Vertex(mesh.Points.size(), Vec3::Zero())
-    , Across(3 * mesh.Triangles.size(), -1)
-  {
-    std::vector<std::pair<std::uint64_t, int>> edges;
-    edges.reserve(3 * mesh.Triangles.size());
-    for (std::size_t f = 0; f < mesh.Triangles.size(); ++f)
-    {
-      const Triangle& t = mesh.Triangles[f];
-      const Vec3 n = areaNormal(mesh, t);
-      const double len = n.norm();
-      Face[f] = len > 0 ? Vec3(n / len) : Vec3::Zero();
-      for (int k = 0; k < 3; ++k)
-      {
-        const Vec3& p = mesh.Points[t[k]];
-        const Vec3 u = mesh.Points[t[(k + 1) % 3]] - p, w = mesh.Points[t[(k + 2) % 3]] - p;
-        Vertex[t[k]] += std::atan2(u.cross(w).norm(), u.dot(w)) * Face[f];
-        const std::uint32_t a = static_cast<std::uint32_t>(std::min(t[k], t[(k + 1) % 3]));
-        const std::uint32_t b = static_cast<std::uint32_t>(std::max(t[k], t[(k + 1) % 3]));
-        edges.emplace_back((std::uint64_t(a) << 32) | b, static_cast<int>(3 * f + k));
-      }
-    }
-    tbb::parallel_sort(edges.begin(), edges.end());
-    for (std::size_t i = 0; i + 1 < edges.size(); ++i)
-      if (edges[i].first == edges[i + 1].first)
-      {
-        Across[static_cast<std::size_t>(edges[i].second)] = edges[i + 1].second / 3;
-        Across[static_cast<std::size_t>(edges[i + 1].second)] = edges[i].second / 3;
-      }
-  }
-
-  const Vec3& faceNormal(int f) const { return Face[static_cast<std::size_t>(f)]; }
-
-  /// x's closest point on the mesh is cp, on triangle f: is x outside?
-  bool outside(const Vec3& x, int f, const Vec3& cp) const
-  {
-    const Triangle& t = M.Triangles[static_cast<std::size_t>(f)];
-    const Vec3 &a = M.Points[t[0]], &b = M.Points[t[1]], &c = M.Points[t[2]];
-    const double area = areaNormal(M, t).norm();
-    Vec3 n = Face[static_cast<std::size_t>(f)];
-    if (area > 0)
-    {
-      // barycentric weights of cp: a weight near 0 puts it on the opposite edge
-      const double w[3] = { (b - cp).cross(c - cp).norm() / area, (c - cp).cross(a - cp).norm() / area,
-        (a - cp).cross(b - cp).norm() / area };
-      const double eps = 1e-7;
-      int zeros = 0, zero = -1, nonzero = -1;
-      for (int k = 0; k < 3; ++k)
-        if (w[k] < eps)
-        {
-          ++zeros;
-          zero = k;
-        }
-        else
-          nonzero = k;
-      if (zeros >= 2)
-        n = Vertex[static_cast<std::size_t>(t[nonzero])]; // at a corner
-      else if (zeros == 1)
-      {
-        // on the edge opposite corner `zero`: edge k runs from corner k to k + 1
-        const int across = Across[3 * static_cast<std::size_t>(f) + static_cast<std::size_t>((zero + 1) % 3)];
-        if (across >= 0)
-          n = Face[static_cast<std::size_t>(f)] + Face[static_cast<std::size_t>(across)];
-      }
-    }
-    return (x - cp).dot(n) > 0;
-  }
-
-private:
-  const TriangleMesh& M;
-  std::vector<Vec3> Face, Vertex;
-  std::vector<int> Across; ///< the triangle across edge k of f (3 f + k), -1 on a border
-};
-
 /// computeIsosurface's field with a LocalExactField: the amplified field of the grid twice as
 /// coarse (OpenVDB's, from `coarse` and its closest triangles `coarseClosest`, positions in
 /// `order`), interpolated onto the grid of `voxelSize`, and computed exactly (a query of
@@ -650,6 +569,7 @@ openvdb::FloatGrid::Ptr localExactField(const openvdb::FloatGrid& coarse, const 
         auto idx = coarseClosest.getConstAccessor();
         auto values = coarse.getConstAccessor();
         auto& mine = found.local();
+        // a voxel's closest point and the normal of its triangle (false where it has none)
         const auto closestAt = [&](const openvdb::Coord& ijk, Vec3& cp, Vec3& n) {
           const int position = idx.getValue(ijk);
           if (position < 0 || position >= static_cast<int>(order.size()))
@@ -663,23 +583,37 @@ openvdb::FloatGrid::Ptr localExactField(const openvdb::FloatGrid& coarse, const 
           n = sign.faceNormal(t);
           return true;
         };
+        // each voxel's, computed once for its leaf (a neighbour across the leaf's +x, +y or +z
+        // face is computed again)
+        std::vector<Vec3> cps(CoarseLeaf::SIZE), normals(CoarseLeaf::SIZE);
+        std::vector<char> has(CoarseLeaf::SIZE);
         for (std::size_t l = r.begin(); l != r.end(); ++l)
         {
           const CoarseLeaf& cl = *coarseLeaves[l];
+          std::fill(has.begin(), has.end(), 0);
+          for (auto it = cl.cbeginValueOn(); it; ++it)
+            has[it.pos()] = closestAt(it.getCoord(), cps[it.pos()], normals[it.pos()]) ? 1 : 0;
           for (auto it = cl.cbeginValueOn(); it; ++it)
           {
-            const openvdb::Coord ijk = it.getCoord();
-            Vec3 cp, n;
-            if (!closestAt(ijk, cp, n))
+            if (!has[it.pos()])
               continue;
+            const openvdb::Coord ijk = it.getCoord();
+            const Vec3 &cp = cps[it.pos()], &n = normals[it.pos()];
+            const openvdb::Coord within = ijk - cl.origin();
             for (int axis = 0; axis < 3; ++axis)
             {
               openvdb::Coord next = ijk;
               next[axis] += 1;
-              if (!values.isValueOn(next))
-                continue;
               Vec3 cq, m;
-              if (!closestAt(next, cq, m))
+              if (within[axis] + 1 < static_cast<int>(CoarseLeaf::DIM))
+              {
+                const openvdb::Index o = CoarseLeaf::coordToOffset(next);
+                if (!cl.isValueOn(o) || !has[o])
+                  continue;
+                cq = cps[o];
+                m = normals[o];
+              }
+              else if (!values.isValueOn(next) || !closestAt(next, cq, m))
                 continue;
               if (n.dot(m) < 0 && (cq - cp).dot(n) > 0 && (cp - cq).dot(m) > 0)
               {
@@ -1046,7 +980,6 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
   auto t0 = std::chrono::steady_clock::now();
 
   std::atomic<bool> expanding{ false };
-  auto transform = openvdb::math::Transform::createLinearTransform(voxelSize);
 
   // The isosurface at `iso` needs values up to iso plus one voxel. Corners beyond the band read the
   // background (band width), which is still > iso: the crossing can only move outward (the safe
@@ -1144,7 +1077,15 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
         order[f] = source[order[f]];
     }
   }
-  const CancellableMeshAdapter adapter(points, tris, progress, &expanding);
+  // OpenVDB's field on the grid of voxel h (voxelSize or a multiple of it), its band out to the
+  // isovalue plus a voxel
+  const auto vdbField = [&](double h, float interior, int flags) {
+    const CancellableMeshAdapter adapter(points, tris, progress, &expanding, voxelSize / h);
+    const auto transform = openvdb::math::Transform::createLinearTransform(h);
+    const float exterior = static_cast<float>(std::ceil(iso / h) + 1.0);
+    return openvdb::tools::meshToVolume<openvdb::FloatGrid>(
+      sdfInterrupter, adapter, *transform, exterior, interior, flags, closestTriangle.get());
+  };
   const bool localField = local && amplification && !unsignedField && !ownBand && local->Tree &&
     local->Dilation > 0;
   openvdb::BoolTree::Ptr localMask;
@@ -1152,16 +1093,9 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
   {
     if (localField)
     {
-      // the grid twice as coarse (index space: half the coordinates), amplified on its own voxels
-      std::vector<openvdb::Vec3s> coarsePoints(points.size());
-      for (std::size_t i = 0; i < points.size(); ++i)
-        coarsePoints[i] = points[i] * 0.5f;
-      const CancellableMeshAdapter coarseAdapter(coarsePoints, tris, progress, &expanding);
+      // the grid twice as coarse, amplified on its own voxels
       const double coarseVoxel = 2.0 * voxelSize;
-      const auto coarseTransform = openvdb::math::Transform::createLinearTransform(coarseVoxel);
-      const float coarseBand = static_cast<float>(std::ceil(iso / coarseVoxel) + 1.0);
-      openvdb::FloatGrid::Ptr coarse = openvdb::tools::meshToVolume<openvdb::FloatGrid>(
-        sdfInterrupter, coarseAdapter, *coarseTransform, coarseBand, 1.0f, 0, closestTriangle.get());
+      openvdb::FloatGrid::Ptr coarse = vdbField(coarseVoxel, 1.0f, 0);
       if (coarse && !progressCancelled(progress))
       {
         openvdb::BoolTree coarseMask(coarse->tree(), false, openvdb::TopologyCopy());
@@ -1183,8 +1117,7 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
     }
     else
     {
-      grid = openvdb::tools::meshToVolume<openvdb::FloatGrid>(sdfInterrupter, adapter, *transform, exteriorBand,
-        interiorBand, unsignedField ? openvdb::tools::UNSIGNED_DISTANCE_FIELD : 0, closestTriangle.get());
+      grid = vdbField(voxelSize, interiorBand, unsignedField ? openvdb::tools::UNSIGNED_DISTANCE_FIELD : 0);
     }
   }
   catch (const std::exception& e)

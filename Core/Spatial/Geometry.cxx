@@ -1,4 +1,7 @@
 #include "Spatial/Geometry.h"
+#include "Mesh/EdgeKey.h"
+
+#include <tbb/parallel_sort.h>
 
 #include <algorithm>
 #include <cmath>
@@ -269,6 +272,71 @@ double windingNumber(const TriangleMesh& mesh, const Vec3& p)
     total += solidAngle(mesh.Points[t[0]], mesh.Points[t[1]], mesh.Points[t[2]], p);
   }
   return total / (4.0 * M_PI);
+}
+
+PseudoNormalSign::PseudoNormalSign(const TriangleMesh& mesh)
+  : M(mesh)
+  , Face(mesh.Triangles.size(), Vec3::Zero())
+  , Vertex(mesh.Points.size(), Vec3::Zero())
+  , Across(3 * mesh.Triangles.size(), -1)
+{
+  std::vector<std::pair<std::uint64_t, int>> edges;
+  edges.reserve(3 * mesh.Triangles.size());
+  for (std::size_t f = 0; f < mesh.Triangles.size(); ++f)
+  {
+    const Triangle& t = mesh.Triangles[f];
+    const Vec3 n = areaNormal(mesh, t);
+    const double len = n.norm();
+    Face[f] = len > 0 ? Vec3(n / len) : Vec3::Zero();
+    for (int k = 0; k < 3; ++k)
+    {
+      const Vec3& p = mesh.Points[t[k]];
+      const Vec3 u = mesh.Points[t[(k + 1) % 3]] - p, w = mesh.Points[t[(k + 2) % 3]] - p;
+      Vertex[t[k]] += std::atan2(u.cross(w).norm(), u.dot(w)) * Face[f];
+      edges.emplace_back(edgeKey(t[k], t[(k + 1) % 3]), static_cast<int>(3 * f + k));
+    }
+  }
+  tbb::parallel_sort(edges.begin(), edges.end());
+  for (std::size_t i = 0; i + 1 < edges.size(); ++i)
+    if (edges[i].first == edges[i + 1].first)
+    {
+      Across[static_cast<std::size_t>(edges[i].second)] = edges[i + 1].second / 3;
+      Across[static_cast<std::size_t>(edges[i + 1].second)] = edges[i].second / 3;
+    }
+}
+
+bool PseudoNormalSign::outside(const Vec3& x, int f, const Vec3& cp) const
+{
+  const Triangle& t = M.Triangles[static_cast<std::size_t>(f)];
+  const Vec3 &a = M.Points[t[0]], &b = M.Points[t[1]], &c = M.Points[t[2]];
+  const double area = areaNormal(M, t).norm();
+  Vec3 n = Face[static_cast<std::size_t>(f)];
+  if (area > 0)
+  {
+    // barycentric weights of cp: a weight near 0 puts it on the opposite edge
+    const double w[3] = { (b - cp).cross(c - cp).norm() / area, (c - cp).cross(a - cp).norm() / area,
+      (a - cp).cross(b - cp).norm() / area };
+    const double eps = 1e-7;
+    int zeros = 0, zero = -1, nonzero = -1;
+    for (int k = 0; k < 3; ++k)
+      if (w[k] < eps)
+      {
+        ++zeros;
+        zero = k;
+      }
+      else
+        nonzero = k;
+    if (zeros >= 2)
+      n = Vertex[static_cast<std::size_t>(t[nonzero])]; // at a corner
+    else if (zeros == 1)
+    {
+      // on the edge opposite corner `zero`: edge k runs from corner k to k + 1
+      const int across = Across[3 * static_cast<std::size_t>(f) + static_cast<std::size_t>((zero + 1) % 3)];
+      if (across >= 0)
+        n = Face[static_cast<std::size_t>(f)] + Face[static_cast<std::size_t>(across)];
+    }
+  }
+  return (x - cp).dot(n) > 0;
 }
 
 } // namespace sdfcage

@@ -4,6 +4,7 @@
 #include "Mesh/Mesh.h"
 
 #include <cmath>
+#include <vector>
 
 namespace sdfcage
 {
@@ -51,5 +52,28 @@ inline double solidAngle(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3
 
 /// Generalized winding number of a closed triangle mesh at p (about 1 inside, 0 outside).
 double windingNumber(const TriangleMesh& mesh, const Vec3& p);
+
+/// The side of a closed, consistently oriented mesh a point is on, from its closest point: the
+/// angle-weighted pseudo-normal of the closest feature (face, edge or vertex) points to the
+/// outside (Baerentzen and Aanaes, "Signed distance computation using the angle weighted
+/// pseudonormal", 2005). Written here: OpenVDB signs whole grids by flood fill, and a field
+/// computed only near some points (the topology repair's local grid) has no closed band to fill
+/// from. The mesh must outlive this.
+class PseudoNormalSign
+{
+public:
+  explicit PseudoNormalSign(const TriangleMesh& mesh);
+
+  /// Triangle f's unit normal (zero when it is degenerate).
+  const Vec3& faceNormal(int f) const { return Face[static_cast<std::size_t>(f)]; }
+
+  /// x's closest point on the mesh is cp, on triangle f: is x outside?
+  bool outside(const Vec3& x, int f, const Vec3& cp) const;
+
+private:
+  const TriangleMesh& M;
+  std::vector<Vec3> Face, Vertex;
+  std::vector<int> Across; ///< the triangle across edge k of f (3 f + k), -1 on a border
+};
 
 } // namespace sdfcage

@@ -618,3 +618,99 @@ TEST(Geometry, CloserThanAgreesWithTheDistance)
   EXPECT_GT(apart, 200);
   EXPECT_GT(closer, 4000);
 }
+
+namespace
+{
+
+/// The prism over a polygon of the xy plane star-shaped from its first corner (its caps fanned
+/// from there), from z = 0 to z = height, oriented outward.
+TriangleMesh extrudedPolygon(const std::vector<Vec3>& polygon, double height)
+{
+  TriangleMesh m;
+  const int n = static_cast<int>(polygon.size());
+  for (const Vec3& p : polygon)
+    m.Points.push_back(p);
+  for (const Vec3& p : polygon)
+    m.Points.push_back(p + Vec3(0, 0, height));
+  for (int k = 1; k + 1 < n; ++k)
+  {
+    m.Triangles.push_back({ 0, k + 1, k });
+    m.Triangles.push_back({ n, n + k, n + k + 1 });
+  }
+  for (int k = 0; k < n; ++k)
+  {
+    const int a = k, b = (k + 1) % n;
+    m.Triangles.push_back({ a, b, n + b });
+    m.Triangles.push_back({ a, n + b, n + a });
+  }
+  double volume = 0.0;
+  for (const Triangle& t : m.Triangles)
+    volume += m.Points[t[0]].dot(m.Points[t[1]].cross(m.Points[t[2]]));
+  if (volume < 0)
+    for (Triangle& t : m.Triangles)
+      std::swap(t[1], t[2]);
+  return m;
+}
+
+} // namespace
+
+// The pseudo-normal sign (the topology repair's local grid) against the winding number, on
+// closed meshes free of self-intersection (the cluster at 0.004: see GapShapes) with convex, concave and sharp corners and edges:
+// points near every vertex (whose closest feature is then mostly a vertex or an edge, where a
+// face's own normal can give the wrong side) and near random surface points. The face normal
+// alone must get some of them wrong, else the points would not test the edge and vertex rules.
+TEST(PseudoNormalSign, AgreesWithTheWindingNumberNearCornersAndEdges)
+{
+  // an L (a concave edge) and a sliver of 10 degrees (convex edges sharper than a right angle)
+  const TriangleMesh ell = extrudedPolygon(
+    { Vec3(0, 0, 0), Vec3(0.8, 0, 0), Vec3(0.8, 0.3, 0), Vec3(0.3, 0.3, 0), Vec3(0.3, 0.8, 0), Vec3(0, 0.8, 0) }, 0.4);
+  const TriangleMesh sliver =
+    extrudedPolygon({ Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(std::cos(0.1745), std::sin(0.1745), 0) }, 0.3);
+  const std::vector<std::pair<const char*, TriangleMesh>> meshes = { { "box",
+                                                                       makeBox(Vec3(-0.5, -0.3, -0.2), Vec3(0.4, 0.3, 0.2)) },
+    { "ell", ell }, { "sliver", sliver }, { "comb", makeGapShape(GapShape::Comb, 0.01) },
+    { "cluster", makeGapShape(GapShape::Cluster, 0.004) } };
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int faceWrong = 0;
+  for (const auto& [name, mesh] : meshes)
+  {
+    SCOPED_TRACE(name);
+    const TriangleTree tree(mesh);
+    const PseudoNormalSign sign(mesh);
+    std::vector<Vec3> points;
+    // (at most about 300 vertices: the winding numbers are brute-force sums)
+    const std::size_t every = 1 + mesh.Points.size() / 300;
+    for (std::size_t i = 0; i < mesh.Points.size(); i += every)
+      for (double eps : { 1e-4, 3e-3 })
+        for (int k = 0; k < 4; ++k)
+          points.push_back(mesh.Points[i] + eps * Vec3(u(rng), u(rng), u(rng)));
+    for (int k = 0; k < 600; ++k)
+    {
+      const Triangle& t = mesh.Triangles[static_cast<std::size_t>(k) % mesh.Triangles.size()];
+      const double a = 0.5 * (u(rng) + 1.0), b = 0.5 * (u(rng) + 1.0) * (1.0 - a);
+      const Vec3 on = mesh.Points[t[0]] + a * (mesh.Points[t[1]] - mesh.Points[t[0]]) +
+        b * (mesh.Points[t[2]] - mesh.Points[t[0]]);
+      points.push_back(on + 0.01 * Vec3(u(rng), u(rng), u(rng)));
+    }
+    int wrong = 0, decided = 0;
+    for (const Vec3& x : points)
+    {
+      Vec3 cp;
+      int f = -1;
+      double d = 0.0;
+      ASSERT_TRUE(tree.closestPoint(x, -1.0, cp, f, d));
+      const double w = windingNumber(mesh, x);
+      if (d < 1e-9 || std::abs(w - 0.5) < 0.25)
+        continue; // on the surface, or not clearly on one side
+      ++decided;
+      const bool out = w < 0.5;
+      wrong += sign.outside(x, f, cp) != out ? 1 : 0;
+      faceWrong += ((x - cp).dot(sign.faceNormal(f)) > 0) != out ? 1 : 0;
+    }
+    EXPECT_GT(decided, static_cast<int>(points.size()) / 2);
+    EXPECT_EQ(wrong, 0) << "of " << decided;
+  }
+  EXPECT_GT(faceWrong, 0);
+  std::printf("the face normal alone: %d wrong\n", faceWrong);
+}
