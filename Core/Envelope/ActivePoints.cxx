@@ -1,4 +1,5 @@
 #include "Envelope/ActivePoints.h"
+#include "Mesh/EdgeKey.h"
 
 #include "Common/Progress.h"
 
@@ -847,8 +848,7 @@ std::size_t splitEdges(
     --shift;
   std::size_t made = 0;
   auto mid = [&](int a, int b) {
-    const std::uint64_t key =
-      (static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint32_t>(std::max(a, b));
+    const std::uint64_t key = edgeKey(a, b);
     const std::size_t mask = capacity - 1;
     std::size_t i = static_cast<std::size_t>((key * 0x9E3779B97F4A7C15ull) >> shift);
     for (; keys[i] != emptyKey; i = (i + 1) & mask)

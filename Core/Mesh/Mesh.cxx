@@ -1,4 +1,5 @@
 #include "Mesh/Mesh.h"
+#include "Mesh/EdgeKey.h"
 
 #include "Common/LargePages.h"
 
@@ -117,12 +118,7 @@ std::vector<std::uint64_t> uniqueEdgeKeys(const TriangleMesh& mesh, const std::v
   auto add = [&](const Triangle& t) {
     for (int k = 0; k < 3; ++k)
     {
-      std::uint32_t a = static_cast<std::uint32_t>(t[k]), b = static_cast<std::uint32_t>(t[(k + 1) % 3]);
-      if (a > b)
-      {
-        std::swap(a, b);
-      }
-      keys.push_back((static_cast<std::uint64_t>(a) << 32) | b);
+      keys.push_back(edgeKey(t[k], t[(k + 1) % 3]));
     }
   };
   if (subset)

@@ -1,4 +1,5 @@
 #include "Mesh/Validation.h"
+#include "Mesh/EdgeKey.h"
 
 #include "Common/CancellableSort.h"
 #include "Common/LargePages.h"
@@ -423,8 +424,7 @@ bool classifyEdgesBySort(const TriangleMesh& mesh, MeshDefects& d, Progress* pro
     {
       const std::uint32_t a = static_cast<std::uint32_t>(t[k]);
       const std::uint32_t b = static_cast<std::uint32_t>(t[(k + 1) % 3]);
-      const std::uint32_t lo = std::min(a, b), hi = std::max(a, b);
-      he.push_back({ (static_cast<std::uint64_t>(lo) << 32) | hi, static_cast<int>(f), a < b });
+      he.push_back({ edgeKey(t[k], t[(k + 1) % 3]), static_cast<int>(f), a < b });
     }
   }
   if (!cancellableSort(he, [](const HalfEdge& x, const HalfEdge& y) { return x.Key < y.Key; }, progress))
