@@ -912,10 +912,16 @@ double roundToDigits(double x, bool up)
   return (up ? std::ceil(x / unit * (1 - 1e-12)) : std::floor(x / unit * (1 + 1e-12))) * unit;
 }
 
+/// The topology repair rounds' room: their envelope at active points 1.2 times the clearance
+/// away (not 1.15 as the first envelope's): round 1's grid exact only near the gaps missed the
+/// clearance at 1.15 on dragon_quartet by 3e-6 (0.00249743 against 0.0025) however large the
+/// exact region (1 to 8 coarse voxels), and round 2's uniform extraction (its merged one
+/// crossed itself) by 1% on three stacked hooks 0.008 apart (0.000991 against 0.001); at 1.2
+/// both are verified and keep the input's topology.
+constexpr double RepairClearanceRoom = 1.2;
+
 /// The largest alpha that keeps the envelope at an active point (about isoValue / alpha from
 /// the input) 15% beyond the clearance; at least 1 (no amplification).
-/// The local repair grid's room: its envelope at active points 1.2 times the clearance away.
-constexpr double LocalClearanceRoom = 1.2;
 
 double alphaKeepingClearance(double isoValue, double clearance)
 {
@@ -1800,9 +1806,9 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
     o.VoxelSize = round == 1 ? 0.5 * h0 : 0.25 * h0;
     const double delta = round == 2 && automaticClearance ? 0.4 * delta0 : delta0;
     o.MinimumClearance = delta;
-    // the envelope at an active point lies at about c / alpha: keep it 15% beyond the clearance
-    // (the strongest amplification that does: buildEnvelopeOnce would lower a larger one to it)
-    o.ActivePoints.Alpha = alphaKeepingClearance(c, delta);
+    // the envelope at an active point lies at about c / alpha: keep it 20% beyond the clearance
+    // (RepairClearanceRoom; buildEnvelopeOnce would lower a larger one to 15%)
+    o.ActivePoints.Alpha = std::max(1.0, c / (RepairClearanceRoom * delta));
     // The first round's finer grid, with merged polygons wherever the amplification leaves room:
     // OpenVDB merges any unambiguous, manifold block at adaptivity 1 (no normal test), and the
     // samples the round amplifies keep uniform triangles where phi > 1 + 0.5 (alpha - 1) (the
@@ -1849,27 +1855,22 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
     const auto roundStart = std::chrono::steady_clock::now();
     // The round's finer grid is needed where nearly touching parts must stay apart: exact
     // within 4 coarse voxels of the gaps the grid twice as coarse may fuse, the coarse field
-    // interpolated elsewhere (EnvelopeOptions::LocalExactDilation), with the envelope at 1.2
-    // delta at active points instead of 1.15 delta: at 1.15 the local envelope of
-    // dragon_quartet missed the clearance by 3e-6 (0.00249743 against 0.0025) however large
-    // the exact region (1 to 8 voxels). Measured on dragon_quartet (its repair round, whole
-    // runs): round 4.4 s instead of 9.8 s, total 12.5 s instead of 15.2-15.9 s, 353 MB instead
-    // of 378 MB; 0.84 M of 8.1 M voxels exact at 2 voxels, 2.4 M of 9.1 M at 4 (the gaps:
-    // 7,042 coarse voxels). A round that fails so (not verified, or the topology still differs)
-    // is run again on the whole exact grid with the usual amplification.
+    // interpolated elsewhere (EnvelopeOptions::LocalExactDilation). Measured on dragon_quartet
+    // (its repair round, whole runs): round 4.4 s instead of 9.8 s, total 12.5 s instead of
+    // 15.2-15.9 s, 353 MB instead of 378 MB; 0.84 M of 8.1 M voxels exact at 2 voxels, 2.4 M of
+    // 9.1 M at 4 (the gaps: 7,042 coarse voxels). A round that fails so (not verified, or the
+    // topology still differs) is run again on the whole exact grid.
     EnvelopeOptions localOptions = o;
     if (round == 1)
     {
       localOptions.LocalExactDilation = 4;
-      localOptions.ActivePoints.Alpha = std::max(1.0, c / (LocalClearanceRoom * delta));
     }
     EnvelopeResult r = buildEnvelopeOnce(
       unitInput, localOptions.LocalExactDilation > 0 ? localOptions : o, progress, progressEnd, inputClosed ? 1 : 0);
     if (localOptions.LocalExactDilation > 0 && r.State != Status::Cancelled && !progressCancelled(progress) &&
       (r.State != Status::Ok || topologyDiffers(r)))
     {
-      log << ": with the grid exact near the gaps only (" << r.ExactVoxels << " voxels, alpha "
-          << localOptions.ActivePoints.Alpha << "), "
+      log << ": with the grid exact near the gaps only (" << r.ExactVoxels << " voxels), "
           << (r.State != Status::Ok ? std::string("not verified") : "genus " + std::to_string(r.Genus))
           << "; on the exact grid";
       EnvelopeResult exact = buildEnvelopeOnce(unitInput, o, progress, progressEnd, inputClosed ? 1 : 0);
@@ -1877,8 +1878,7 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
       r = std::move(exact);
     }
     else if (localOptions.LocalExactDilation > 0)
-      log << ": with the grid exact near the gaps only (" << r.ExactVoxels << " voxels, alpha "
-          << localOptions.ActivePoints.Alpha << ")";
+      log << ": with the grid exact near the gaps only (" << r.ExactVoxels << " voxels)";
     const double roundSeconds = seconds(roundStart);
     ++rounds;
     if (r.State == Status::Cancelled || progressCancelled(progress))

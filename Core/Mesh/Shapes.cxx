@@ -259,8 +259,11 @@ TriangleMesh gapShapeWorld(GapShape kind, double g)
   const double rho = 0.012, step = 0.008, fillet = 0.02;
   const int sides = 16;
   auto hook = [&](double z, double length) {
-    // a straight part along -x, up, back, and down to `g` above the straight part
-    const double H = 0.055, W = 0.045;
+    // a straight part along -x, up, back, and down to `g` above the straight part; tall enough
+    // that the last bend's arc (roundedPolyline shortens it to half the last segment) keeps a
+    // radius above the tube's: a tighter bend folds the tube's inner side through itself (at
+    // H = 0.055 every gap above 0.0064 did: 20 crossing pairs at 0.01)
+    const double W = 0.045, H = std::max(0.055, 2 * rho + g + 2.2 * rho);
     const std::vector<Vec3> corners{ { -length, 0, z }, { 0, 0, z }, { 0, H, z }, { -W, H, z },
       { -W, 2 * rho + g, z } };
     return makeTube(roundedPolyline(corners, fillet, step), rho, sides, Vec3(0, 1, 0));

@@ -48,8 +48,10 @@ const char* shapeName(GapShape s)
 TEST(GapShapes, ClosedGenusZeroSelfIntersectionFree)
 {
   for (GapShape s : { GapShape::Hook, GapShape::Cluster, GapShape::Ring, GapShape::Comb })
+    for (double gap : { 0.004, 0.01, 0.03 })
   {
-    const TriangleMesh m = makeGapShape(s, 0.004);
+    SCOPED_TRACE(gap);
+    const TriangleMesh m = makeGapShape(s, gap);
     const MeshDefects d = checkTriangleMesh(m);
     EXPECT_TRUE(d.usable()) << shapeName(s);
     EXPECT_EQ(genus(m), 0) << shapeName(s);
@@ -71,7 +73,7 @@ TEST(GapShapes, ClosedGenusZeroSelfIntersectionFree)
       }
       a.Points = b.Points = unit.Points;
       const exact::ExactReport g = exact::exactCheck(a, b, 1.0);
-      EXPECT_NEAR(g.MinimumClearance, 0.004, 1e-6);
+      EXPECT_NEAR(g.MinimumClearance, gap, 1e-6);
     }
   }
 }
