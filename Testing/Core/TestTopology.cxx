@@ -197,6 +197,12 @@ TEST(TopologyRepair, FirstRoundMergesPolygonsAwayFromTheGap)
   EXPECT_TRUE(merged.EnclosureVerified);
   EXPECT_DOUBLE_EQ(merged.AdaptivityUsed, 1.0);
   EXPECT_DOUBLE_EQ(merged.VoxelSizeUsed, 0.5 * o.voxelSize());
+  // the round's grid exact only near the gap (EnvelopeOptions::LocalExactDilation), and that
+  // envelope kept: not run again on the whole exact grid
+  EXPECT_GT(merged.ExactVoxels, 0u);
+  EXPECT_NE(merged.TopologyRepairLog.find("with the grid exact near the gaps only ("), std::string::npos)
+    << merged.TopologyRepairLog;
+  EXPECT_EQ(merged.TopologyRepairLog.find("on the exact grid"), std::string::npos) << merged.TopologyRepairLog;
   const exact::ExactReport e = exact::exactCheck(unit, merged.Envelope, 0.0);
   EXPECT_TRUE(e.Encloses);
   EXPECT_GE(e.MinimumClearance, o.clearance() * (1.0 - 1e-9));
