@@ -1364,6 +1364,12 @@ IsosurfaceOutput computeIsosurface(const TriangleMesh& unitInput, double voxelSi
       try
       {
         bool stopped = false;
+        // OpenVDB's mesher reads the mask by leaf (MergeVoxelRegions: probeConstLeaf at each
+        // leaf's origin) and merges freely under an active tile, and the dilation prunes whole
+        // leaves of the mask into tiles: voxelized, a mask that is on everywhere near the active
+        // points keeps their triangles uniform
+        if (adaptivity > 0.0 && !noAdapt->empty())
+          noAdapt->voxelizeActiveTiles();
         surface = extract(grid, iso, adaptivity, noAdapt->empty() ? nullptr : noAdapt, progress, stopped);
         extractionSeconds += seconds(te);
         if (std::getenv("SDFCAGE_DEBUG_ENVELOPE"))
