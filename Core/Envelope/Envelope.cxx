@@ -1791,6 +1791,16 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
   EnvelopeResult best = std::move(first);
   int rounds = 0;
   const int maxRounds = std::min(options.MaximumTopologyRepairs, 2);
+  // each round's grid, clearance and amplification: the envelope at an active point lies at
+  // about c / alpha, kept 20% beyond the clearance (RepairClearanceRoom; buildEnvelopeOnce would
+  // lower a larger alpha to 15%)
+  const auto roundVoxel = [&](int round) { return round == 1 ? 0.5 * h0 : 0.25 * h0; };
+  const auto roundClearance = [&](int round) { return round == 2 && automaticClearance ? 0.4 * delta0 : delta0; };
+  const auto roundAlpha = [&](int round) { return std::max(1.0, c / (RepairClearanceRoom * roundClearance(round))); };
+  const auto roundVoxels = [&](int round) { return area / (roundVoxel(round) * roundVoxel(round)); };
+  // (is round 2 tried: allowed, with room to amplify and within the surface voxels' limit?)
+  const bool secondRoundTried = maxRounds >= 2 && roundAlpha(2) >= MinimumRepairAlpha &&
+    roundVoxels(2) <= options.MaximumRepairSurfaceVoxels;
   for (int round = 1; round <= maxRounds; ++round)
   {
     EnvelopeOptions o = options;
@@ -1803,12 +1813,10 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
     // still not verified).
     o.MaximumRefinements = 0;
     o.ActivePoints.GapRatio = options.ActivePoints.GapRatio > 0 ? options.ActivePoints.GapRatio : 3.0;
-    o.VoxelSize = round == 1 ? 0.5 * h0 : 0.25 * h0;
-    const double delta = round == 2 && automaticClearance ? 0.4 * delta0 : delta0;
+    o.VoxelSize = roundVoxel(round);
+    const double delta = roundClearance(round);
     o.MinimumClearance = delta;
-    // the envelope at an active point lies at about c / alpha: keep it 20% beyond the clearance
-    // (RepairClearanceRoom; buildEnvelopeOnce would lower a larger one to 15%)
-    o.ActivePoints.Alpha = std::max(1.0, c / (RepairClearanceRoom * delta));
+    o.ActivePoints.Alpha = roundAlpha(round);
     // The first round's finer grid, with merged polygons wherever the amplification leaves room:
     // OpenVDB merges any unambiguous, manifold block at adaptivity 1 (no normal test), and the
     // samples the round amplifies keep uniform triangles where phi > 1 + 0.5 (alpha - 1) (the
@@ -1827,7 +1835,7 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
     {
       o.Adaptivity = 1.0;
     }
-    const double voxels = area / (o.VoxelSize * o.VoxelSize);
+    const double voxels = roundVoxels(round);
     log << "; round " << round << ": voxel " << o.VoxelSize << ", alpha " << o.ActivePoints.Alpha << ", clearance "
         << delta;
     // A clearance close to the isovalue leaves the round almost no amplification: it would
@@ -1859,7 +1867,11 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
     // (its repair round, whole runs): round 4.4 s instead of 9.8 s, total 12.5 s instead of
     // 15.2-15.9 s, 353 MB instead of 378 MB; 0.84 M of 8.1 M voxels exact at 2 voxels, 2.4 M of
     // 9.1 M at 4 (the gaps: 7,042 coarse voxels). A round that fails so (not verified, or the
-    // topology still differs) is run again on the whole exact grid.
+    // topology still differs) is run again on the whole exact grid, unless it was verified
+    // and round 2 follows: that round's grid is exact and finer, and the exact grid of this
+    // round kept the local one's extra handles on every generated gap shape that needed round
+    // 2 (hook 0.004 and 0.008: genus 1 and 1; cluster 0.004: 3 and 3, 0.008: 14 and 13; ring
+    // 0.004: 1 and 1), 0.45-1 s for nothing.
     EnvelopeOptions localOptions = o;
     if (round == 1)
     {
@@ -1868,7 +1880,7 @@ EnvelopeResult buildEnvelope(const TriangleMesh& unitInput, const EnvelopeOption
     EnvelopeResult r = buildEnvelopeOnce(
       unitInput, localOptions.LocalExactDilation > 0 ? localOptions : o, progress, progressEnd, inputClosed ? 1 : 0);
     if (localOptions.LocalExactDilation > 0 && r.State != Status::Cancelled && !progressCancelled(progress) &&
-      (r.State != Status::Ok || topologyDiffers(r)))
+      (r.State != Status::Ok || (topologyDiffers(r) && !secondRoundTried)))
     {
       log << ": with the grid exact near the gaps only (" << r.ExactVoxels << " voxels), "
           << (r.State != Status::Ok ? std::string("not verified") : "genus " + std::to_string(r.Genus))
