@@ -830,14 +830,15 @@ TEST(CageErrors, ClearanceTooCloseToTheIsoValueIsRefusedAtOnce)
     << r.Message;
 
   // just below the bound: a verified envelope, and no topology repair round at an amplification
-  // of 1.24 (it would separate only parts 2c / 1.24 to 2c apart, at 4 to 16 times the cost)
+  // of 1.19 (c / (1.2 delta): it would separate only parts 2c / 1.19 to 2c apart, at 4 to 16
+  // times the cost)
   options.MinimumClearance = 0.007;
   const EnvelopeResult near = buildEnvelope(unit, options);
   ASSERT_EQ(near.State, Status::Ok) << near.Message;
   EXPECT_TRUE(near.EnclosureVerified);
   EXPECT_EQ(near.TopologyRepairs, 0) << near.TopologyRepairLog;
-  EXPECT_NE(near.TopologyRepairLog.find("round 1: voxel 0.0025, alpha 1.24224, clearance 0.007: not tried (the "
-                                        "clearance leaves room for an amplification of 1.24224 only"),
+  EXPECT_NE(near.TopologyRepairLog.find("round 1: voxel 0.0025, alpha 1.19048, clearance 0.007: not tried (the "
+                                        "clearance leaves room for an amplification of 1.19048 only"),
     std::string::npos)
     << near.TopologyRepairLog;
   EXPECT_EQ(near.TopologyRepairLog.find("round 2"), std::string::npos) << "a fixed clearance: round 2 has no more room";
