@@ -643,10 +643,7 @@ TriangleMesh extrudedPolygon(const std::vector<Vec3>& polygon, double height)
     m.Triangles.push_back({ a, b, n + b });
     m.Triangles.push_back({ a, n + b, n + a });
   }
-  double volume = 0.0;
-  for (const Triangle& t : m.Triangles)
-    volume += m.Points[t[0]].dot(m.Points[t[1]].cross(m.Points[t[2]]));
-  if (volume < 0)
+  if (signedVolume(m) < 0)
     for (Triangle& t : m.Triangles)
       std::swap(t[1], t[2]);
   return m;

@@ -184,17 +184,39 @@ TEST(ActivePointAlpha, LoweredWhereItWouldPutTheEnvelopeWithinTheClearance)
   }
 }
 
+namespace
+{
+
+/// The envelope of the hook whose tip is `gap` from its straight part (unit-sphere units, in
+/// `unit`) at the defaults, after `rounds` repair rounds: genus 0, one part, verified, and judged
+/// by the referee (enclosing, no crossing, at least `clearance` from the input).
+EnvelopeResult repairedHook(double gap, int rounds, double clearance, TriangleMesh& unit)
+{
+  const TriangleMesh world = makeGapShape(GapShape::Hook, gap);
+  unit = Normalization::fit(world).toUnit(world);
+  const EnvelopeResult r = buildEnvelope(unit, EnvelopeOptions());
+  EXPECT_EQ(r.State, Status::Ok) << r.Message;
+  EXPECT_EQ(r.TopologyRepairs, rounds) << r.TopologyRepairLog;
+  EXPECT_EQ(r.Genus, 0);
+  EXPECT_EQ(r.Components, 1);
+  EXPECT_TRUE(r.EnclosureVerified);
+  const exact::ExactReport e = exact::exactCheck(unit, r.Envelope, 0.0);
+  EXPECT_TRUE(e.Encloses);
+  EXPECT_EQ(e.SelfIntersections, 0);
+  EXPECT_GE(e.MinimumClearance, clearance * (1.0 - 1e-9));
+  EXPECT_EQ(e.CageGenus, 0);
+  EXPECT_EQ(e.CageComponents, 1);
+  return r;
+}
+
+} // namespace
+
 TEST(TopologyRepair, FirstRoundMergesPolygonsAwayFromTheGap)
 {
-  const TriangleMesh world = makeGapShape(GapShape::Hook, 0.015);
-  const TriangleMesh unit = Normalization::fit(world).toUnit(world);
   EnvelopeOptions o;
-  const EnvelopeResult merged = buildEnvelope(unit, o);
-  ASSERT_EQ(merged.State, Status::Ok) << merged.Message;
-  EXPECT_EQ(merged.TopologyRepairs, 1) << merged.TopologyRepairLog;
-  EXPECT_EQ(merged.Genus, 0);
-  EXPECT_EQ(merged.Components, 1);
-  EXPECT_TRUE(merged.EnclosureVerified);
+  TriangleMesh unit;
+  const EnvelopeResult merged = repairedHook(0.015, 1, o.clearance(), unit);
+  ASSERT_EQ(merged.State, Status::Ok);
   EXPECT_DOUBLE_EQ(merged.AdaptivityUsed, 1.0);
   EXPECT_DOUBLE_EQ(merged.VoxelSizeUsed, 0.5 * o.voxelSize());
   // the round's grid exact only near the gap (EnvelopeOptions::LocalExactDilation), and that
@@ -203,11 +225,6 @@ TEST(TopologyRepair, FirstRoundMergesPolygonsAwayFromTheGap)
   EXPECT_NE(merged.TopologyRepairLog.find("with the grid exact near the gaps only ("), std::string::npos)
     << merged.TopologyRepairLog;
   EXPECT_EQ(merged.TopologyRepairLog.find("on the exact grid"), std::string::npos) << merged.TopologyRepairLog;
-  const exact::ExactReport e = exact::exactCheck(unit, merged.Envelope, 0.0);
-  EXPECT_TRUE(e.Encloses);
-  EXPECT_GE(e.MinimumClearance, o.clearance() * (1.0 - 1e-9));
-  EXPECT_EQ(e.CageGenus, 0);
-  EXPECT_EQ(e.CageComponents, 1);
 
   o.Adaptivity = 0.0;
   const EnvelopeResult uniform = buildEnvelope(unit, o);
@@ -217,7 +234,7 @@ TEST(TopologyRepair, FirstRoundMergesPolygonsAwayFromTheGap)
   EXPECT_LT(2 * merged.Envelope.Triangles.size(), uniform.Envelope.Triangles.size());
 
   // the run reports the kept envelope's adaptivity (the CLI summary and the field data show it)
-  const CageResult cage = generateCage(PolygonMesh::fromTriangles(world), CageOptions());
+  const CageResult cage = generateCage(PolygonMesh::fromTriangles(makeGapShape(GapShape::Hook, 0.015)), CageOptions());
   ASSERT_EQ(cage.State, Status::Ok) << cage.Message;
   EXPECT_EQ(cage.TopologyRepairs, 1);
   EXPECT_DOUBLE_EQ(cage.AdaptivityUsed, 1.0);
@@ -234,23 +251,13 @@ TEST(TopologyRepair, FirstRoundMergesPolygonsAwayFromTheGap)
 // uniform triangles (454k instead of 51k) and the whole run took 10.9 s instead of 2.2 s.
 TEST(TopologyRepair, SecondRoundKeepsItsMergedPolygons)
 {
-  const TriangleMesh world = makeGapShape(GapShape::Hook, 0.008);
-  const TriangleMesh unit = Normalization::fit(world).toUnit(world);
-  EnvelopeOptions o;
-  const EnvelopeResult r = buildEnvelope(unit, o);
-  ASSERT_EQ(r.State, Status::Ok) << r.Message;
-  EXPECT_EQ(r.TopologyRepairs, 2) << r.TopologyRepairLog;
-  EXPECT_EQ(r.Genus, 0);
-  EXPECT_EQ(r.Components, 1);
+  const EnvelopeOptions o;
+  TriangleMesh unit;
+  const EnvelopeResult r = repairedHook(0.008, 2, 0.4 * o.clearance(), unit);
+  ASSERT_EQ(r.State, Status::Ok);
   EXPECT_DOUBLE_EQ(r.VoxelSizeUsed, 0.25 * o.voxelSize());
   EXPECT_DOUBLE_EQ(r.AdaptivityUsed, o.Adaptivity);
   EXPECT_LT(r.Envelope.Triangles.size(), 150000u);
-  const exact::ExactReport e = exact::exactCheck(unit, r.Envelope, 0.0);
-  EXPECT_TRUE(e.Encloses);
-  EXPECT_EQ(e.SelfIntersections, 0);
-  EXPECT_GE(e.MinimumClearance, 0.4 * o.clearance() * (1.0 - 1e-9));
-  EXPECT_EQ(e.CageGenus, 0);
-  EXPECT_EQ(e.CageComponents, 1);
 }
 
 // The strict option: with the repair off, a hook whose tip is 0.004 from its own straight part
