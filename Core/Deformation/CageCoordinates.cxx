@@ -776,12 +776,8 @@ CageBindingResult CageDeformer::bind(const TriangleMesh& restCage, const std::ve
     }
   }
   TriangleMesh cage = restCage;
-  if (signedVolume(cage) < 0.0)
+  if (orientOutward(cage))
   {
-    for (Triangle& t : cage.Triangles)
-    {
-      std::swap(t[1], t[2]);
-    }
     result.CageWasFlipped = true;
   }
   Data& d = *this->D;

@@ -33,6 +33,19 @@ double signedVolume(const TriangleMesh& mesh)
   return v / 6.0;
 }
 
+bool orientOutward(TriangleMesh& mesh)
+{
+  if (!(signedVolume(mesh) < 0.0))
+  {
+    return false;
+  }
+  for (Triangle& t : mesh.Triangles)
+  {
+    std::swap(t[1], t[2]);
+  }
+  return true;
+}
+
 namespace
 {
 int findRoot(std::vector<int>& parent, int i)

@@ -60,6 +60,10 @@ inline Vec3 areaNormal(const TriangleMesh& mesh, const Triangle& t)
 /// Signed volume enclosed by a closed mesh (positive when outward oriented).
 double signedVolume(const TriangleMesh& mesh);
 
+/// Reverses every triangle of a closed mesh whose signed volume is negative (inward oriented),
+/// which orients it outward; returns whether it did.
+bool orientOutward(TriangleMesh& mesh);
+
 /// Connected components over shared vertices: returns the component id per triangle and the
 /// number of components.
 int triangleComponents(const TriangleMesh& mesh, std::vector<int>& componentOfTriangle);

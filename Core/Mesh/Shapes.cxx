@@ -234,19 +234,7 @@ TriangleMesh makeTube(const std::vector<Vec3>& c, double radius, int sides, cons
       m.Triangles.push_back({ id(i, j), id(i + 1, j + 1), id(i + 1, j) });
     }
   }
-  // outward: a positive enclosed volume
-  double volume = 0.0;
-  for (const Triangle& t : m.Triangles)
-  {
-    volume += m.Points[t[0]].dot(m.Points[t[1]].cross(m.Points[t[2]]));
-  }
-  if (volume < 0)
-  {
-    for (Triangle& t : m.Triangles)
-    {
-      std::swap(t[1], t[2]);
-    }
-  }
+  orientOutward(m);
   return m;
 }
 

@@ -358,13 +358,7 @@ TriangleMesh tetrahedron(const Vec3& a, const Vec3& b, const Vec3& c, const Vec3
   TriangleMesh m;
   m.Points = { a, b, c, d };
   m.Triangles = { { 0, 2, 1 }, { 0, 1, 3 }, { 1, 2, 3 }, { 2, 0, 3 } };
-  if (signedVolume(m) < 0)
-  {
-    for (Triangle& t : m.Triangles)
-    {
-      std::swap(t[1], t[2]);
-    }
-  }
+  orientOutward(m);
   return m;
 }
 } // namespace

@@ -643,9 +643,7 @@ TriangleMesh extrudedPolygon(const std::vector<Vec3>& polygon, double height)
     m.Triangles.push_back({ a, b, n + b });
     m.Triangles.push_back({ a, n + b, n + a });
   }
-  if (signedVolume(m) < 0)
-    for (Triangle& t : m.Triangles)
-      std::swap(t[1], t[2]);
+  orientOutward(m);
   return m;
 }
 
