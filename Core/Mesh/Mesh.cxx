@@ -33,16 +33,21 @@ double signedVolume(const TriangleMesh& mesh)
   return v / 6.0;
 }
 
+void reverseOrientation(TriangleMesh& mesh)
+{
+  for (Triangle& t : mesh.Triangles)
+  {
+    std::swap(t[1], t[2]);
+  }
+}
+
 bool orientOutward(TriangleMesh& mesh)
 {
   if (!(signedVolume(mesh) < 0.0))
   {
     return false;
   }
-  for (Triangle& t : mesh.Triangles)
-  {
-    std::swap(t[1], t[2]);
-  }
+  reverseOrientation(mesh);
   return true;
 }
 

@@ -60,6 +60,9 @@ inline Vec3 areaNormal(const TriangleMesh& mesh, const Triangle& t)
 /// Signed volume enclosed by a closed mesh (positive when outward oriented).
 double signedVolume(const TriangleMesh& mesh);
 
+/// Reverses every triangle (swaps its last two corners): outward becomes inward and back.
+void reverseOrientation(TriangleMesh& mesh);
+
 /// Reverses every triangle of a closed mesh whose signed volume is negative (inward oriented),
 /// which orients it outward; returns whether it did.
 bool orientOutward(TriangleMesh& mesh);

@@ -40,10 +40,7 @@ TriangleMesh append(TriangleMesh a, const TriangleMesh& b)
 
 TriangleMesh inverted(TriangleMesh m)
 {
-  for (Triangle& t : m.Triangles)
-  {
-    std::swap(t[1], t[2]);
-  }
+  reverseOrientation(m);
   return m;
 }
 

@@ -335,10 +335,7 @@ TEST(CageCoordinates, InwardCageIsUsedReversed)
 {
   const TorusCase c;
   TriangleMesh inward = c.Cage;
-  for (Triangle& t : inward.Triangles)
-  {
-    std::swap(t[1], t[2]);
-  }
+  reverseOrientation(inward);
   Eigen::Matrix3d a = 1.2 * Eigen::AngleAxisd(0.4, Vec3::UnitZ()).toRotationMatrix();
   for (CageCoordinateKind kind : Kinds)
   {

@@ -281,10 +281,7 @@ TEST(CageQuality, InwardOrientedCageEnclosesAndIsReported)
 {
   const TriangleMesh sphere = unitSphere();
   TriangleMesh box = cube(1.5);
-  for (Triangle& t : box.Triangles)
-  {
-    std::swap(t[1], t[2]);
-  }
+  reverseOrientation(box);
   const CageQualityResult q = evaluateCage(sphere, box);
   EXPECT_TRUE(q.Encloses) << q.Message;
   EXPECT_TRUE(q.CageInwardOriented);

@@ -278,10 +278,7 @@ TEST(Geometry, WindingNumberInsideOutside)
 
   // A flipped mesh gives about -1 inside; a torus's hole is outside.
   TriangleMesh flipped = sphere;
-  for (Triangle& t : flipped.Triangles)
-  {
-    std::swap(t[1], t[2]);
-  }
+  reverseOrientation(flipped);
   EXPECT_NEAR(windingNumber(flipped, Vec3(0.5, -0.25, 2.0)), -1.0, 0.01);
   const TriangleMesh torus = makeTorus(Vec3(0, 0, 0), 1.0, 0.3, 48, 16);
   EXPECT_NEAR(windingNumber(torus, Vec3(0, 0, 0)), 0.0, 0.01);

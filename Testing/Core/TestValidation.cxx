@@ -357,10 +357,7 @@ TEST(Validation, InwardMeshIsFlipped)
   TriangleMesh sphere = makeSphere(Vec3(1, 2, 3), 2.0, 24, 12);
   const double outwardVolume = signedVolume(sphere);
   ASSERT_GT(outwardVolume, 0.0);
-  for (Triangle& t : sphere.Triangles)
-  {
-    std::swap(t[1], t[2]);
-  }
+  reverseOrientation(sphere);
   ASSERT_LT(signedVolume(sphere), 0.0);
   TriangleMesh out;
   const MeshDefects d = prepareMesh(PolygonMesh::fromTriangles(sphere), out);
