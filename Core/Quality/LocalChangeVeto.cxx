@@ -66,19 +66,15 @@ const char* verdictName(LocalChangeVerdict v)
   return "?";
 }
 
-LocalChangeVerdict LocalChangeVeto::check(
-  LocalChangeScratch& s, const MovedVertex* moved, VertexDistanceRef distance, LocalChangeFindings* findings) const
+LocalChangeVerdict LocalChangeVeto::check(LocalChangeScratch& s, LocalChangeFindings* findings) const
 {
   if (findings)
-  {
     findings->Read = false;
-    findings->MovedDistanceExact = false;
-  }
   if (!shapeOk(s.Tris))
     return LocalChangeVerdict::Shape;
   if (Policy.CheckSelfIntersection && !foldFree(s.Tris))
     return LocalChangeVerdict::Fold;
-  if (Policy.Input != LocalChangePolicy::InputTest::None && !inputClear(s.Tris, moved, distance, findings))
+  if (Policy.Input != LocalChangePolicy::InputTest::None && !inputClear(s.Tris))
     return LocalChangeVerdict::InputClearance;
   if (Policy.CheckSelfIntersection && !selfIntersectionFree(s, findings))
     return LocalChangeVerdict::SelfIntersection;
@@ -113,59 +109,16 @@ bool LocalChangeVeto::foldFree(const std::vector<ChangedTriangle>& tris) const
   return true;
 }
 
-bool LocalChangeVeto::inputClear(const std::vector<ChangedTriangle>& tris, const MovedVertex* moved,
-  VertexDistanceRef distance, LocalChangeFindings* findings) const
+bool LocalChangeVeto::inputClear(const std::vector<ChangedTriangle>& tris) const
 {
-  const double delta = Policy.Clearance;
-  // The triangles left to the exact test go to the tree together (anyCloserThanAny: one walk
-  // for all, the same verdict). Measured, median of 5 (session 48): the simplification of
-  // octopus-low 0.214 -> 0.199 s, armadillo 0.461 -> 0.425 s, anchor 0.159 -> 0.145 s.
-  // The price: the corner bound is taken for every changed triangle before the walk, where one
-  // walk per triangle stopped at the first the tree rejected, so a rejected change may look up
-  // a few more corner distances (exact and cached by the caller: the verdicts are the same).
+  // The triangles go to the tree together (anyCloserThanAny: one walk for all, the same
+  // verdict). Measured, median of 5 (session 48): the simplification of octopus-low 0.214 ->
+  // 0.199 s, armadillo 0.461 -> 0.425 s, anchor 0.159 -> 0.145 s.
   const Vec3* exact[32];
   int exacts = 0;
-  auto exactlyClear = [&]() { return !Input.anyCloserThanAny(exact, exacts, delta); };
-  if (Policy.Input != LocalChangePolicy::InputTest::Bounded || !moved)
-  {
-    for (const ChangedTriangle& t : tris)
-    {
-      exact[exacts++] = t.Pts;
-      if (exacts == 32 && !exactlyClear())
-        return false;
-      exacts %= 32;
-    }
-    return exactlyClear();
-  }
-  // Early-outs from the distance being 1-Lipschitz. A point x of a triangle with barycentric
-  // weights l_k satisfies sum_k l_k |x - v_k|^2 = sum_k l_k |v_k - o|^2 - |x - o|^2 for any o,
-  // so with o the centroid, the average of |x - v_k| is at most R (the corners' largest
-  // distance from the centroid) and d(x) >= sum_k l_k (D(v_k) - |x - v_k|) >= min_k D(v_k) - R.
-  // D at the moved vertex comes from one query bounded by delta + max R (beyond it, that bound is
-  // all we need); the other corners' distances from `distance` (cached by the caller). Triangles
-  // the bound does not clear get the exact triangle-input distance through the tree.
-  double maxR = 0;
-  for (const ChangedTriangle& t : tris)
-    maxR = std::max(maxR, t.R);
-  const double limit = delta + maxR;
-  Vec3 c;
-  int tri;
-  double dp;
-  if (!Input.closestPoint(moved->To, limit, c, tri, dp))
-    dp = limit;
-  else if (findings)
-  {
-    findings->MovedDistance = dp;
-    findings->MovedDistanceExact = true;
-  }
+  auto exactlyClear = [&]() { return !Input.anyCloserThanAny(exact, exacts, Policy.Clearance); };
   for (const ChangedTriangle& t : tris)
   {
-    double lo = dp;
-    for (int k = 0; k < 3 && lo - t.R > delta * (1 + 1e-9); ++k)
-      if (t.Ids[k] != moved->Id)
-        lo = std::min(lo, distance(t.Ids[k]));
-    if (lo - t.R > delta * (1 + 1e-9))
-      continue;
     exact[exacts++] = t.Pts;
     if (exacts == 32 && !exactlyClear())
       return false;

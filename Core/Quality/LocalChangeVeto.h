@@ -82,10 +82,8 @@ struct LocalChangePolicy
   double Clearance = 0.0025;
   enum class InputTest
   {
-    None,   ///< not tested (off, or already established by the caller)
-    Exact,  ///< every new triangle through the tree
-    Bounded ///< skip the triangles a 1-Lipschitz bound from the moved vertex and the cached
-            ///< corner distances already clears, then exact through the tree (the simplifier)
+    None,  ///< not tested (off, or already established by the caller)
+    Exact, ///< every new triangle through the tree
   };
   InputTest Input = InputTest::Exact;
   /// Fold and SelfIntersection are tested (the simplifier's unconstrained mode turns them off).
@@ -121,42 +119,12 @@ struct ChangedTriangle
   double R = 0;
 };
 
-/// The moved vertex of a change whose new triangles all have it as a corner (an edge collapse, a
-/// vertex move), for the bounded input test.
-struct MovedVertex
-{
-  int Id = -1;
-  Vec3 To = Vec3::Zero();
-};
-
-/// The distance (or a lower bound) from a cage vertex to the input, for the bounded input test:
-/// a non-owning reference to a callable double(int).
-class VertexDistanceRef
-{
-public:
-  VertexDistanceRef() = default;
-  template <typename F, typename = std::enable_if_t<!std::is_same<std::decay_t<F>, VertexDistanceRef>::value>>
-  VertexDistanceRef(F& f) // NOLINT: implicit on purpose
-    : Object(&f)
-    , Call([](void* o, int v) { return (*static_cast<F*>(o))(v); })
-  {
-  }
-  double operator()(int v) const { return Call(Object, v); }
-
-private:
-  void* Object = nullptr;
-  double (*Call)(void*, int) = nullptr;
-};
-
 /// What the veto learnt besides the verdict.
 struct LocalChangeFindings
 {
   /// The SelfIntersection check ran: the cage triangles it read lie within [ReadLo, ReadHi].
   bool Read = false;
   Vec3 ReadLo = Vec3::Zero(), ReadHi = Vec3::Zero();
-  /// The bounded input test measured the moved vertex's exact distance to the input.
-  bool MovedDistanceExact = false;
-  double MovedDistance = -1;
 };
 
 /// Per-thread scratch of the veto: the change (filled by the caller) and reusable buffers.
@@ -212,10 +180,8 @@ public:
   void setPolicy(const LocalChangePolicy& p) { Policy = p; }
 
   /// Runs the named checks on the change in s (Tris, Replaced) in order; the first that fails is
-  /// the verdict. `moved` and `distance` serve the bounded input test (InputTest::Bounded); the
-  /// findings, if given, are reset and filled.
-  LocalChangeVerdict check(LocalChangeScratch& s, const MovedVertex* moved = nullptr,
-    VertexDistanceRef distance = VertexDistanceRef(), LocalChangeFindings* findings = nullptr) const;
+  /// the verdict. The findings, if given, are reset and filled.
+  LocalChangeVerdict check(LocalChangeScratch& s, LocalChangeFindings* findings = nullptr) const;
 
   // ---- the named checks (check() runs them in this order) ----
   /// No needle, no flip; fills N, C and R of the triangles.
@@ -223,9 +189,8 @@ public:
   /// No two new triangles conflict (fold onto each other across a shared edge, cross, or come
   /// closer than the self clearance).
   bool foldFree(const std::vector<ChangedTriangle>& tris) const;
-  /// Every new triangle keeps the clearance to the input (needs shapeOk's R for Bounded).
-  bool inputClear(const std::vector<ChangedTriangle>& tris, const MovedVertex* moved, VertexDistanceRef distance,
-    LocalChangeFindings* findings) const;
+  /// Every new triangle keeps the clearance to the input.
+  bool inputClear(const std::vector<ChangedTriangle>& tris) const;
   /// No new triangle conflicts with a cage triangle that is alive and not replaced.
   bool selfIntersectionFree(LocalChangeScratch& s, LocalChangeFindings* findings) const;
 

@@ -128,10 +128,6 @@ struct Eval
   double Cost = 0;
   bool HasRead = false; // the cage triangles read lie within [ReadLo, ReadHi]
   Vec3 ReadLo = Vec3::Zero(), ReadHi = Vec3::Zero();
-  std::vector<std::pair<int, double>> Dist; // vertex distances to the input measured
-  Vec3 LastCheckPos = Vec3::Zero();
-  double LastCheckDistance = -1;
-  bool LastCheckExact = false; // check() measured the exact distance of LastCheckPos
   long long RejInput = 0, RejSelf = 0, RejShape = 0;
   Scratch* S = nullptr;
 };
@@ -179,7 +175,6 @@ public:
       for (int v : T[f])
         VT[v].push_back(static_cast<int>(f));
     Ver.assign(P.size(), 0);
-    D.assign(P.size(), -1.0);
     VStamp.assign(P.size(), 0);
     BlockedAt.assign(P.size(), {});
     AliveVertices = static_cast<int>(P.size());
@@ -468,9 +463,6 @@ public:
           Heap.push(ev.E); // evaluated on a neighbourhood that has changed since: again later
           continue;
         }
-        for (const auto& vd : ev.Dist)
-          if (D[vd.first] < 0)
-            D[vd.first] = vd.second;
         Stats.RejectedInput += ev.RejInput;
         Stats.RejectedSelf += ev.RejSelf;
         Stats.RejectedShape += ev.RejShape;
@@ -547,8 +539,6 @@ public:
     ev.S = &s;
     ev.Gathered = ev.Feasible = ev.Relocated = false;
     ev.HasRead = false;
-    ev.Dist.clear();
-    ev.LastCheckExact = false;
     ev.RejInput = ev.RejSelf = ev.RejShape = 0;
     ev.Gathered = gather(ev);
     if (!ev.Gathered)
@@ -677,26 +667,6 @@ public:
   }
 
 private:
-  // distance from cage vertex v to the input (exact, or a lower bound when beyond a cap),
-  // measured when first needed after v moved (kept in ev until the batch applies it)
-  double vertexDistance(int v, Eval& ev) const
-  {
-    if (D[v] >= 0)
-      return D[v];
-    for (const auto& vd : ev.Dist)
-      if (vd.first == v)
-        return vd.second;
-    // bounded query: beyond the cap, the cap itself is a valid lower bound and enough to clear
-    // any triangle of the dense and middle stages
-    const double cap = 16.0 * Opt.Clearance;
-    Vec3 c;
-    int tri;
-    double d;
-    const double value = Input.closestPoint(P[v], cap, c, tri, d) ? d : cap;
-    ev.Dist.emplace_back(v, value);
-    return value;
-  }
-
   // ---- adjacency ----
   std::vector<int> neighbours(int v) const
   {
@@ -845,16 +815,8 @@ private:
       const Triangle& old = T[ev.Changed[i]];
       nt.Reference = (P[old[1]] - P[old[0]]).cross(P[old[2]] - P[old[0]]);
     }
-    const MovedVertex moved{ ev.C0, p };
-    auto distance = [&](int v) { return vertexDistance(v, ev); };
     LocalChangeFindings found;
-    const LocalChangeVerdict v = Veto.check(s, &moved, distance, &found);
-    ev.LastCheckExact = found.MovedDistanceExact;
-    if (found.MovedDistanceExact)
-    {
-      ev.LastCheckPos = p;
-      ev.LastCheckDistance = found.MovedDistance;
-    }
+    const LocalChangeVerdict v = Veto.check(s, &found);
     if (found.Read)
     {
       if (ev.HasRead)
@@ -933,7 +895,15 @@ private:
     p.MinimumTriangleQuality = o.MinimumTriangleQuality;
     p.MinimumNormalCosine = o.MinimumNormalCosine;
     p.Clearance = o.Clearance;
-    p.Input = o.EnforceClearance ? LocalChangePolicy::InputTest::Bounded : LocalChangePolicy::InputTest::None;
+    // Every new triangle goes to the input's tree (one walk for all). A 1-Lipschitz bound from
+    // cached vertex distances used to clear some first, but it cleared only about 4% of them
+    // (the new triangles are larger than the room between the envelope and the clearance) and
+    // cost a distance query per check: without it the cages are the same byte for byte and
+    // `sdfcage_simplify_benchmark` runs faster (session 57, best of 3, three alternating rounds:
+    // armadillo 0.69-0.78 -> 0.54-0.64 s, octopus-low 0.29-0.34 -> 0.26-0.32 s, anchor
+    // 0.26-0.30 -> 0.25-0.27 s; best of 1, two rounds: dragon_vrip 2.03-2.34 -> 2.01-2.08 s,
+    // armadillo_midsub4x 0.76-0.83 -> 0.62-0.72 s).
+    p.Input = o.EnforceClearance ? LocalChangePolicy::InputTest::Exact : LocalChangePolicy::InputTest::None;
     p.CheckSelfIntersection = o.EnforceNoSelfIntersection;
     p.SelfClearance = o.selfClearance();
     return p;
@@ -1087,7 +1057,6 @@ private:
       box(f, lo, hi);
       Grid.insert(f, lo, hi);
     }
-    D[c0] = ev.LastCheckExact && ev.LastCheckPos == p ? ev.LastCheckDistance : -1.0;
     neighbours(c0, Ring);
     const std::vector<int>& ring = Ring;
     for (int v : { c0, c1 })
@@ -1154,7 +1123,6 @@ private:
   std::vector<char> VAlive, TAlive;
   std::vector<std::vector<int>> VT;
   std::vector<Quadric> Q;
-  std::vector<double> D; // distance (or lower bound) to the input per vertex, < 0 = not known
   std::vector<unsigned> Ver;
   std::vector<unsigned> VStamp; // == BatchStamp: written by a collapse of the current batch
   unsigned BatchStamp = 0;
