@@ -19,6 +19,7 @@ void TriangleIndex::build(const TriangleMesh& mesh, double cellSize)
     this->Dims = { 1, 1, 1 };
     this->CellStart.assign(2, 0);
     this->CellTriangles.clear();
+    this->MinCell.clear();
     return;
   }
   if (!(cellSize > 0.0))
@@ -48,6 +49,7 @@ void TriangleIndex::build(const TriangleMesh& mesh, double cellSize)
   }
   const std::int64_t ncells = static_cast<std::int64_t>(Dims[0]) * Dims[1] * Dims[2];
   this->CellStart.assign(ncells + 1, 0);
+  this->MinCell.resize(nf);
   // two passes: count, then fill
   for (int pass = 0; pass < 2; ++pass)
   {
@@ -68,6 +70,8 @@ void TriangleIndex::build(const TriangleMesh& mesh, double cellSize)
       const Vec3 hi = mesh.Points[t[0]].cwiseMax(mesh.Points[t[1]]).cwiseMax(mesh.Points[t[2]]);
       std::array<int, 3> a, b;
       this->cellRange(lo, hi, a, b);
+      if (pass == 0)
+        this->MinCell[f] = a;
       for (int k = a[2]; k <= b[2]; ++k)
         for (int j = a[1]; j <= b[1]; ++j)
           for (int i = a[0]; i <= b[0]; ++i)

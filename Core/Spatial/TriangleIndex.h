@@ -3,6 +3,8 @@
 
 #include "Mesh/Mesh.h"
 
+#include <algorithm>
+#include <array>
 #include <cstdint>
 #include <vector>
 
@@ -44,6 +46,11 @@ private:
   std::array<int, 3> Dims{ 0, 0, 0 };
   std::vector<std::int64_t> CellStart; // size = #cells + 1
   std::vector<int> CellTriangles;
+  // per triangle: the first cell its box covers (cellRange of its box's minimum), so a query
+  // tells which of its cells reports a triangle without a division per candidate (the
+  // verification's conflict stage on octopus-low's first envelope 0.024-0.026 -> 0.019-0.020 s,
+  // session 57)
+  std::vector<std::array<int, 3>> MinCell;
 };
 
 template <typename F>
@@ -68,11 +75,10 @@ void TriangleIndex::forEachTriangleInBox(const Vec3& lo, const Vec3& hi, F&& f) 
           {
             continue;
           }
-          // report once: from the cell that contains the max of both box minima
-          const Vec3 m = tlo.cwiseMax(lo);
-          std::array<int, 3> mc, dummy;
-          this->cellRange(m, m, mc, dummy);
-          if (mc[0] == i && mc[1] == j && mc[2] == k)
+          // report once: from the cell that contains the max of both box minima (the cell of a
+          // maximum is the maximum of the cells: floor and the clamp are monotonic)
+          const std::array<int, 3>& mc = MinCell[t];
+          if (std::max(mc[0], a[0]) == i && std::max(mc[1], a[1]) == j && std::max(mc[2], a[2]) == k)
           {
             f(t);
           }
